@@ -1,0 +1,193 @@
+//! Mesh file formats, one file each. The format is chosen by file extension
+//! (and, for the ambiguous `.msh`, by the first keyword: Gmsh's `$MeshFormat`
+//! or GiD's `MESH`).
+//!
+//! Readers return [`MeshData`]; writers take a [`TetMesh`]. Every error names
+//! the file and, where there is one, the line. Writers go through
+//! [`write_atomic`], so a failed write never leaves a partial file behind.
+
+pub mod medit;
+mod text;
+
+pub use text::Tokens;
+
+use crate::mesh::{MeshData, TetMesh};
+use std::fmt;
+use std::fs::File;
+use std::io::{BufWriter, Write};
+use std::path::{Path, PathBuf};
+
+/// A file that could not be read or written, with the place and the problem.
+#[derive(Debug, Clone, PartialEq)]
+pub struct IoError {
+    /// The file.
+    pub path: PathBuf,
+    /// 1-based line, when the problem has one.
+    pub line: Option<usize>,
+    /// What is wrong, in one sentence.
+    pub message: String,
+}
+
+impl IoError {
+    /// An error at a line of a file.
+    pub fn at(path: &Path, line: usize, message: impl Into<String>) -> IoError {
+        IoError {
+            path: path.to_path_buf(),
+            line: Some(line),
+            message: message.into(),
+        }
+    }
+
+    /// An error about a whole file.
+    pub fn file(path: &Path, message: impl Into<String>) -> IoError {
+        IoError {
+            path: path.to_path_buf(),
+            line: None,
+            message: message.into(),
+        }
+    }
+}
+
+impl fmt::Display for IoError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self.line {
+            Some(l) => write!(f, "{}:{}: {}", self.path.display(), l, self.message),
+            None => write!(f, "{}: {}", self.path.display(), self.message),
+        }
+    }
+}
+
+impl std::error::Error for IoError {}
+
+/// The mesh formats this crate reads and writes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Format {
+    /// Medit / MMG `.mesh` (ASCII).
+    Medit,
+    /// Gmsh `.msh`, 2.2 or 4.1, ASCII or binary (writes 4.1 ASCII).
+    Gmsh,
+    /// GiD `.msh` (reads only).
+    Gid,
+    /// VTK XML unstructured grid `.vtu`.
+    Vtu,
+    /// TetGen `.node` / `.ele` / `.face`.
+    Tetgen,
+}
+
+fn extension(path: &Path) -> String {
+    path.extension()
+        .and_then(|e| e.to_str())
+        .unwrap_or("")
+        .to_ascii_lowercase()
+}
+
+impl Format {
+    /// The format of a file to read, from its extension (and content for `.msh`).
+    pub fn for_reading(path: &Path) -> Result<Format, IoError> {
+        match extension(path).as_str() {
+            "mesh" => Ok(Format::Medit),
+            "vtu" => Ok(Format::Vtu),
+            "node" | "ele" | "face" => Ok(Format::Tetgen),
+            "msh" => {
+                let mut head = [0u8; 64];
+                let n = {
+                    use std::io::Read;
+                    let mut f = File::open(path).map_err(|e| IoError::file(path, open_message(&e)))?;
+                    f.read(&mut head).map_err(|e| IoError::file(path, e.to_string()))?
+                };
+                let text = String::from_utf8_lossy(&head[..n]);
+                let first = text.split_whitespace().next().unwrap_or("");
+                if first.eq_ignore_ascii_case("MESH") {
+                    Ok(Format::Gid)
+                } else {
+                    Ok(Format::Gmsh)
+                }
+            }
+            "" => Err(IoError::file(path, "has no extension; use .mesh, .msh, .vtu, .node or .ele")),
+            other => Err(IoError::file(
+                path,
+                format!("unknown mesh extension '.{other}'; use .mesh, .msh, .vtu, .node or .ele"),
+            )),
+        }
+    }
+
+    /// The format of a file to write, from its extension.
+    pub fn for_writing(path: &Path) -> Result<Format, IoError> {
+        match extension(path).as_str() {
+            "mesh" => Ok(Format::Medit),
+            "vtu" => Ok(Format::Vtu),
+            "msh" => Ok(Format::Gmsh),
+            "node" | "ele" => Ok(Format::Tetgen),
+            other => Err(IoError::file(
+                path,
+                format!("cannot write '.{other}'; use .mesh, .msh (Gmsh 4.1), .vtu or .node/.ele (TetGen)"),
+            )),
+        }
+    }
+}
+
+/// A readable sentence for a failed open.
+pub(crate) fn open_message(e: &std::io::Error) -> String {
+    match e.kind() {
+        std::io::ErrorKind::NotFound => "no such file".to_string(),
+        std::io::ErrorKind::PermissionDenied => "permission denied".to_string(),
+        _ => e.to_string(),
+    }
+}
+
+/// Reads the whole file, with a clear error.
+pub(crate) fn read_bytes(path: &Path) -> Result<Vec<u8>, IoError> {
+    std::fs::read(path).map_err(|e| IoError::file(path, open_message(&e)))
+}
+
+/// Reads a mesh, choosing the format by extension.
+pub fn read_mesh(path: &Path) -> Result<MeshData, IoError> {
+    match Format::for_reading(path)? {
+        Format::Medit => medit::read(path),
+        other => Err(IoError::file(path, format!("reading {other:?} is not supported yet"))),
+    }
+}
+
+/// Reads a mesh and builds the store; build errors name the file and line.
+pub fn load_mesh(path: &Path) -> Result<(TetMesh, crate::mesh::BuildReport), IoError> {
+    let data = read_mesh(path)?;
+    TetMesh::from_data(&data).map_err(|e| IoError {
+        path: path.to_path_buf(),
+        line: e.line().map(|l| l as usize),
+        message: e.to_string(),
+    })
+}
+
+/// Writes `mesh` in the format given by the extension of `path`.
+pub fn write_mesh(path: &Path, mesh: &TetMesh) -> Result<(), IoError> {
+    match Format::for_writing(path)? {
+        Format::Medit => medit::write(path, mesh),
+        other => Err(IoError::file(path, format!("writing {other:?} is not supported yet"))),
+    }
+}
+
+/// Writes through a temporary file beside `path` and renames it into place,
+/// so that a failure (or a crash) never leaves a partial output file.
+pub fn write_atomic(
+    path: &Path,
+    body: impl FnOnce(&mut BufWriter<File>) -> std::io::Result<()>,
+) -> Result<(), IoError> {
+    let dir = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "out".into());
+    let tmp = dir.join(format!(".{name}.{}.tmp", std::process::id()));
+    let result = (|| {
+        let f = File::create(&tmp)?;
+        let mut w = BufWriter::with_capacity(1 << 20, f);
+        body(&mut w)?;
+        w.flush()?;
+        w.into_inner().map_err(|e| e.into_error())?.sync_all()?;
+        std::fs::rename(&tmp, path)
+    })();
+    result.map_err(|e| {
+        let _ = std::fs::remove_file(&tmp);
+        IoError::file(path, format!("cannot write: {}", open_message(&e)))
+    })
+}

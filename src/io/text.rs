@@ -1,0 +1,148 @@
+//! A whitespace tokenizer over a text file that knows line numbers, shared by
+//! the ASCII readers so that every parse error can name its line.
+
+use super::IoError;
+use std::path::Path;
+use std::str::FromStr;
+
+/// Tokens of a text file, with the 1-based line of each; `#` starts a comment
+/// to the end of the line when `hash_comments` is set.
+pub struct Tokens<'a> {
+    path: &'a Path,
+    text: &'a str,
+    pos: usize,
+    line: usize,
+    hash_comments: bool,
+    last_line: usize,
+}
+
+impl<'a> Tokens<'a> {
+    /// A tokenizer over `text`, read from `path` (for messages).
+    pub fn new(path: &'a Path, text: &'a str, hash_comments: bool) -> Tokens<'a> {
+        Tokens {
+            path,
+            text,
+            pos: 0,
+            line: 1,
+            hash_comments,
+            last_line: 1,
+        }
+    }
+
+    /// Line of the token returned last.
+    pub fn line(&self) -> usize {
+        self.last_line
+    }
+
+    /// The file these tokens come from.
+    pub fn path(&self) -> &Path {
+        self.path
+    }
+
+    fn skip_space(&mut self) {
+        let b = self.text.as_bytes();
+        while self.pos < b.len() {
+            match b[self.pos] {
+                b'\n' => {
+                    self.line += 1;
+                    self.pos += 1;
+                }
+                b'#' if self.hash_comments => {
+                    while self.pos < b.len() && b[self.pos] != b'\n' {
+                        self.pos += 1;
+                    }
+                }
+                c if c.is_ascii_whitespace() => self.pos += 1,
+                _ => break,
+            }
+        }
+    }
+
+    /// The next token, or `None` at the end of the file.
+    #[allow(clippy::should_implement_trait)]
+    pub fn next(&mut self) -> Option<&'a str> {
+        self.skip_space();
+        let b = self.text.as_bytes();
+        if self.pos >= b.len() {
+            self.last_line = self.line;
+            return None;
+        }
+        let start = self.pos;
+        while self.pos < b.len() && !b[self.pos].is_ascii_whitespace() {
+            self.pos += 1;
+        }
+        self.last_line = self.line;
+        Some(&self.text[start..self.pos])
+    }
+
+    /// The next token without consuming it.
+    pub fn peek(&mut self) -> Option<&'a str> {
+        let (pos, line, last) = (self.pos, self.line, self.last_line);
+        let t = self.next();
+        self.pos = pos;
+        self.line = line;
+        self.last_line = last;
+        t
+    }
+
+    /// An error at the line of the last token.
+    pub fn error(&self, message: impl Into<String>) -> IoError {
+        IoError::at(self.path, self.last_line, message)
+    }
+
+    /// The next token parsed as `T`; `what` names it in the message.
+    pub fn parse<T: FromStr>(&mut self, what: &str) -> Result<T, IoError> {
+        match self.next() {
+            None => Err(IoError::at(
+                self.path,
+                self.line,
+                format!("file ends where {what} was expected (truncated?)"),
+            )),
+            Some(tok) => tok
+                .parse::<T>()
+                .map_err(|_| self.error(format!("expected {what}, found '{}'", shorten(tok)))),
+        }
+    }
+
+    /// The next token parsed as a finite `f64`.
+    pub fn coord(&mut self, what: &str) -> Result<f64, IoError> {
+        let x: f64 = self.parse(what)?;
+        if !x.is_finite() {
+            return Err(self.error(format!("{what} is {x}, not a finite number")));
+        }
+        Ok(x)
+    }
+
+    /// The next token as a 1-based index in `1..=n`, returned 0-based.
+    pub fn index1(&mut self, what: &str, n: usize) -> Result<u32, IoError> {
+        let i: i64 = self.parse(what)?;
+        if i < 1 || i as u64 > n as u64 {
+            return Err(self.error(format!("{what} {i} is out of range 1..={n}")));
+        }
+        Ok((i - 1) as u32)
+    }
+
+    /// Skips the rest of the current line.
+    pub fn skip_line(&mut self) {
+        let b = self.text.as_bytes();
+        while self.pos < b.len() && b[self.pos] != b'\n' {
+            self.pos += 1;
+        }
+    }
+}
+
+fn shorten(s: &str) -> String {
+    if s.chars().count() > 24 {
+        format!("{}…", s.chars().take(24).collect::<String>())
+    } else {
+        s.to_string()
+    }
+}
+
+/// The file as UTF-8 text, or a clear error for binary garbage.
+pub(crate) fn as_text<'a>(path: &Path, bytes: &'a [u8]) -> Result<&'a str, IoError> {
+    std::str::from_utf8(bytes).map_err(|e| {
+        let line = bytes[..e.valid_up_to()].iter().filter(|&&c| c == b'\n').count() + 1;
+        IoError::at(path, line, "not a text file (invalid UTF-8): expected an ASCII mesh")
+    })
+}

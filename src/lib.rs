@@ -1,0 +1,14 @@
+//! # tetrefine
+//!
+//! Adaptive, feature-preserving √3-inspired refinement of tetrahedral meshes
+//! for finite-element simulation.
+
+#![warn(missing_docs)]
+
+pub mod geom;
+pub mod io;
+pub mod mesh;
+pub mod report;
+
+pub use mesh::{MeshData, TetMesh};
+pub use report::MeshStats;

@@ -1,0 +1,471 @@
+//! Building a [`TetMesh`] from [`MeshData`]: validation, orientation and face
+//! adjacency by sorting half-faces (O(n log n), parallel).
+
+use super::{edge_key, face_key, MeshData, TetMesh, NO_ADJ};
+use crate::geom::{orient3d_sign, Orientation, TET_FACES};
+use glam::DVec3;
+use rayon::prelude::*;
+use std::collections::{HashMap, HashSet};
+use std::fmt;
+
+/// Why a mesh could not be built. Tet and point numbers in messages are
+/// 1-based, as in Medit, Gmsh and most solver files; `line` is the file line
+/// when the reader knew it.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum MeshError {
+    /// The mesh has no tetrahedra.
+    #[error("the mesh has no tetrahedra")]
+    Empty,
+    /// A coordinate is NaN or infinite.
+    #[error("point {point} has a non-finite coordinate {coords:?}")]
+    NonFinite {
+        /// 1-based point number.
+        point: usize,
+        /// The coordinates as read.
+        coords: [f64; 3],
+    },
+    /// A tet refers to a point that does not exist.
+    #[error("{at}refers to point {index} but the mesh has {n_points} points")]
+    IndexOutOfRange {
+        /// Where (tet and line).
+        at: Where,
+        /// The 1-based index found.
+        index: u64,
+        /// Number of points.
+        n_points: usize,
+    },
+    /// A tet repeats a vertex.
+    #[error("{at}repeats a vertex {vertices:?}")]
+    RepeatedVertex {
+        /// Where (tet and line).
+        at: Where,
+        /// Its 1-based vertices.
+        vertices: [u64; 4],
+    },
+    /// A tet has zero volume (exact predicate).
+    #[error("{at}has zero volume: its four points are coplanar")]
+    ZeroVolume {
+        /// Where (tet and line).
+        at: Where,
+    },
+    /// Two tets have the same four vertices.
+    #[error("{at}duplicates tetrahedron {other}")]
+    DuplicateTet {
+        /// Where (tet and line).
+        at: Where,
+        /// 1-based number of the earlier tet.
+        other: usize,
+    },
+    /// More than two tets share one face.
+    #[error("{at}shares face {face:?} with {count} tetrahedra in all (a face may have at most two): the mesh is not manifold")]
+    NonManifoldFace {
+        /// Where (one of the tets and its line).
+        at: Where,
+        /// 1-based vertex numbers of the face.
+        face: [u64; 3],
+        /// How many tets hold it.
+        count: usize,
+    },
+    /// Two tets that share a face lie on the same side of it (overlap).
+    #[error("{at}overlaps its neighbour across face {face:?}: both lie on the same side of it")]
+    Overlap {
+        /// Where.
+        at: Where,
+        /// 1-based face vertices.
+        face: [u64; 3],
+    },
+    /// A tag refers to a point that does not exist.
+    #[error("a {what} refers to point {index} but the mesh has {n_points} points")]
+    TagOutOfRange {
+        /// Which kind of tag (triangle, edge, corner).
+        what: &'static str,
+        /// 1-based index.
+        index: u64,
+        /// Number of points.
+        n_points: usize,
+    },
+    /// Region list length does not match tets.
+    #[error("{regions} region values for {tets} tetrahedra")]
+    RegionCount {
+        /// Number of region values.
+        regions: usize,
+        /// Number of tets.
+        tets: usize,
+    },
+}
+
+/// A position for error messages: 1-based tet number and, if known, file line.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Where {
+    /// 1-based tet number.
+    pub tet: usize,
+    /// 1-based line of the file, if known.
+    pub line: Option<u32>,
+}
+
+impl fmt::Display for Where {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        // The line, when known, is reported by the caller (as `file:line:`).
+        write!(f, "tetrahedron {} ", self.tet)
+    }
+}
+
+impl MeshError {
+    /// The file line the error concerns, if known.
+    pub fn line(&self) -> Option<u32> {
+        match self {
+            MeshError::IndexOutOfRange { at, .. }
+            | MeshError::RepeatedVertex { at, .. }
+            | MeshError::ZeroVolume { at }
+            | MeshError::DuplicateTet { at, .. }
+            | MeshError::NonManifoldFace { at, .. }
+            | MeshError::Overlap { at, .. } => at.line,
+            _ => None,
+        }
+    }
+}
+
+/// What building changed or dropped, for the user to know.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct BuildReport {
+    /// Tets given with negative orientation and turned around.
+    pub reoriented: usize,
+    /// Points no tet uses (kept, but not counted as nodes).
+    pub unreferenced_points: usize,
+    /// Marked triangles that are not a face of any tet (dropped).
+    pub dropped_triangles: usize,
+    /// Tagged edges that are not an edge of any tet (dropped).
+    pub dropped_edges: usize,
+}
+
+fn one_based3(f: [u32; 3]) -> [u64; 3] {
+    [f[0] as u64 + 1, f[1] as u64 + 1, f[2] as u64 + 1]
+}
+
+impl TetMesh {
+    /// Builds the store from plain data, validating everything.
+    ///
+    /// Negatively oriented tets are turned around (counted in the report);
+    /// zero-volume tets, repeated or out-of-range vertices, duplicate tets,
+    /// faces shared by more than two tets and non-finite coordinates are
+    /// errors. Runs in O(n log n): half-faces are matched by a parallel sort.
+    pub fn from_data(data: &MeshData) -> Result<(TetMesh, BuildReport), MeshError> {
+        let n_points = data.points.len();
+        let nt = data.tets.len();
+        if nt == 0 {
+            return Err(MeshError::Empty);
+        }
+        if !data.tet_regions.is_empty() && data.tet_regions.len() != nt {
+            return Err(MeshError::RegionCount {
+                regions: data.tet_regions.len(),
+                tets: nt,
+            });
+        }
+        let at = |t: usize| Where {
+            tet: t + 1,
+            line: data.tet_lines.get(t).copied(),
+        };
+        if let Some((i, p)) = data
+            .points
+            .iter()
+            .enumerate()
+            .find(|(_, p)| !p.iter().all(|c| c.is_finite()))
+        {
+            return Err(MeshError::NonFinite {
+                point: i + 1,
+                coords: *p,
+            });
+        }
+        let points: Vec<DVec3> = data.points.iter().map(|p| DVec3::from_array(*p)).collect();
+
+        // Indices, repeated vertices and orientation, in parallel; the first
+        // error in tet order wins so that messages are deterministic.
+        let oriented: Vec<Result<([u32; 4], bool), MeshError>> = data
+            .tets
+            .par_iter()
+            .enumerate()
+            .map(|(t, &v)| {
+                if let Some(&bad) = v.iter().find(|&&x| x as usize >= n_points) {
+                    return Err(MeshError::IndexOutOfRange {
+                        at: at(t),
+                        index: bad as u64 + 1,
+                        n_points,
+                    });
+                }
+                if v[0] == v[1] || v[0] == v[2] || v[0] == v[3] || v[1] == v[2] || v[1] == v[3] || v[2] == v[3] {
+                    return Err(MeshError::RepeatedVertex {
+                        at: at(t),
+                        vertices: v.map(|x| x as u64 + 1),
+                    });
+                }
+                let p = v.map(|x| points[x as usize]);
+                match orient3d_sign(p[0], p[1], p[2], p[3]) {
+                    Orientation::Positive => Ok((v, false)),
+                    Orientation::Negative => Ok(([v[1], v[0], v[2], v[3]], true)),
+                    Orientation::Zero => Err(MeshError::ZeroVolume { at: at(t) }),
+                }
+            })
+            .collect();
+        let mut tets = Vec::with_capacity(nt);
+        let mut reoriented = 0;
+        for r in oriented {
+            let (v, flipped) = r?;
+            reoriented += flipped as usize;
+            tets.push(v);
+        }
+
+        // Duplicate tets: sort the sorted quadruples.
+        let mut quads: Vec<([u32; 4], u32)> = tets
+            .par_iter()
+            .enumerate()
+            .map(|(t, v)| {
+                let mut s = *v;
+                s.sort_unstable();
+                (s, t as u32)
+            })
+            .collect();
+        quads.par_sort_unstable();
+        if let Some(w) = quads.windows(2).find(|w| w[0].0 == w[1].0) {
+            return Err(MeshError::DuplicateTet {
+                at: at(w[1].1 as usize),
+                other: w[0].1 as usize + 1,
+            });
+        }
+        drop(quads);
+
+        // Face adjacency: sort all 4n half-faces by sorted key.
+        let mut half: Vec<(FaceKeyPacked, u32)> = tets
+            .par_iter()
+            .enumerate()
+            .flat_map_iter(|(t, v)| {
+                (0..4).map(move |f| {
+                    let l = TET_FACES[f];
+                    (pack(face_key([v[l[0]], v[l[1]], v[l[2]]])), (4 * t + f) as u32)
+                })
+            })
+            .collect();
+        half.par_sort_unstable();
+        let mut adj = vec![[NO_ADJ; 4]; nt];
+        let mut i = 0;
+        while i < half.len() {
+            let mut j = i + 1;
+            while j < half.len() && half[j].0 == half[i].0 {
+                j += 1;
+            }
+            match j - i {
+                1 => {}
+                2 => {
+                    let (a, b) = (half[i].1, half[i + 1].1);
+                    adj[(a >> 2) as usize][(a & 3) as usize] = b;
+                    adj[(b >> 2) as usize][(b & 3) as usize] = a;
+                }
+                count => {
+                    let t = (half[i].1 >> 2) as usize;
+                    return Err(MeshError::NonManifoldFace {
+                        at: at(t),
+                        face: one_based3(unpack(half[i].0)),
+                        count,
+                    });
+                }
+            }
+            i = j;
+        }
+        drop(half);
+
+        // Two positive tets sharing a face must lie on opposite sides of it: the
+        // neighbour's opposite vertex must be on the side our outward-oriented
+        // face points to.
+        let overlap = (0..nt).into_par_iter().find_first(|&t| {
+            (0..4).any(|f| {
+                let h = adj[t][f];
+                if h == NO_ADJ || ((h >> 2) as usize) < t {
+                    return false;
+                }
+                let v = tets[t];
+                let l = TET_FACES[f];
+                let o = tets[(h >> 2) as usize][(h & 3) as usize];
+                orient3d_sign(
+                    points[v[l[0]] as usize],
+                    points[v[l[1]] as usize],
+                    points[v[l[2]] as usize],
+                    points[o as usize],
+                ) != Orientation::Positive
+            })
+        });
+        if let Some(t) = overlap {
+            let f = (0..4)
+                .find(|&f| {
+                    let h = adj[t][f];
+                    h != NO_ADJ && {
+                        let l = TET_FACES[f];
+                        let v = tets[t];
+                        let o = tets[(h >> 2) as usize][(h & 3) as usize];
+                        orient3d_sign(
+                            points[v[l[0]] as usize],
+                            points[v[l[1]] as usize],
+                            points[v[l[2]] as usize],
+                            points[o as usize],
+                        ) != Orientation::Positive
+                    }
+                })
+                .unwrap_or(0);
+            let l = TET_FACES[f];
+            let v = tets[t];
+            return Err(MeshError::Overlap {
+                at: at(t),
+                face: one_based3([v[l[0]], v[l[1]], v[l[2]]]),
+            });
+        }
+
+        let mut referenced = vec![false; n_points];
+        for v in &tets {
+            for &x in v {
+                referenced[x as usize] = true;
+            }
+        }
+        let unreferenced_points = referenced.iter().filter(|&&r| !r).count();
+
+        let mut mesh = TetMesh {
+            points,
+            region: if data.tet_regions.is_empty() {
+                vec![0; nt]
+            } else {
+                data.tet_regions.clone()
+            },
+            level: vec![0; nt],
+            parent: (0..nt as u32).collect(),
+            generation: vec![0; nt],
+            tets,
+            adj,
+            ..Default::default()
+        };
+        let mut report = BuildReport {
+            reoriented,
+            unreferenced_points,
+            ..Default::default()
+        };
+        mesh.attach_tags(data, &mut report)?;
+        Ok((mesh, report))
+    }
+
+    /// Copies the tags of `data` onto the mesh, dropping (and counting) those
+    /// that name no face or edge of it.
+    fn attach_tags(&mut self, data: &MeshData, report: &mut BuildReport) -> Result<(), MeshError> {
+        let n = self.points.len();
+        let check = |what: &'static str, v: u32| {
+            if v as usize >= n {
+                Err(MeshError::TagOutOfRange {
+                    what,
+                    index: v as u64 + 1,
+                    n_points: n,
+                })
+            } else {
+                Ok(())
+            }
+        };
+        for (f, _) in &data.triangles {
+            for &v in f {
+                check("triangle", v)?;
+            }
+        }
+        for (e, _) in &data.edges {
+            for &v in e {
+                check("edge", v)?;
+            }
+        }
+        for &v in data.corners.iter().chain(&data.required_vertices) {
+            check("vertex tag", v)?;
+        }
+        if !data.triangles.is_empty() {
+            let faces: HashSet<[u32; 3]> = self
+                .tets
+                .iter()
+                .flat_map(|v| TET_FACES.iter().map(move |l| face_key([v[l[0]], v[l[1]], v[l[2]]])))
+                .collect();
+            for &(f, m) in &data.triangles {
+                let k = face_key(f);
+                if faces.contains(&k) {
+                    self.face_markers.insert(k, m);
+                } else {
+                    report.dropped_triangles += 1;
+                }
+            }
+        }
+        if !data.edges.is_empty() {
+            let edges: HashSet<[u32; 2]> = self
+                .tets
+                .iter()
+                .flat_map(|v| crate::geom::TET_EDGES.iter().map(move |e| edge_key(v[e[0]], v[e[1]])))
+                .collect();
+            let mut tagged = HashMap::new();
+            for &([a, b], m) in &data.edges {
+                let k = edge_key(a, b);
+                if edges.contains(&k) {
+                    tagged.insert(k, m);
+                } else {
+                    report.dropped_edges += 1;
+                }
+            }
+            self.feature_edges = tagged;
+        }
+        self.corners = data.corners.iter().copied().collect();
+        self.required = data.required_vertices.iter().copied().collect();
+        Ok(())
+    }
+
+    /// The mesh as plain data: live tets in id order, every point slot, tags.
+    /// Call [`TetMesh::compact`] first for a dense numbering.
+    pub fn to_data(&self) -> MeshData {
+        let ids: Vec<u32> = self.tet_ids().collect();
+        let mut triangles: Vec<([u32; 3], i32)> =
+            self.face_markers.iter().map(|(k, &m)| (*k, m)).collect();
+        // Boundary faces are written with their outward orientation, as Medit
+        // and Gmsh expect; interface faces keep their sorted order.
+        let outward: HashMap<[u32; 3], [u32; 3]> = ids
+            .iter()
+            .flat_map(|&t| {
+                (0..4)
+                    .filter(move |&f| self.adj[t as usize][f] == NO_ADJ)
+                    .map(move |f| {
+                        let fv = self.face_vertices(t, f);
+                        (face_key(fv), fv)
+                    })
+            })
+            .collect();
+        for (f, _) in triangles.iter_mut() {
+            if let Some(o) = outward.get(f) {
+                *f = *o;
+            }
+        }
+        triangles.sort_unstable_by_key(|(f, m)| (face_key(*f), *m));
+        let mut edges: Vec<([u32; 2], i32)> = self.feature_edges.iter().map(|(k, &m)| (*k, m)).collect();
+        edges.sort_unstable();
+        let mut corners: Vec<u32> = self.corners.iter().copied().collect();
+        corners.sort_unstable();
+        let mut required_vertices: Vec<u32> = self.required.iter().copied().collect();
+        required_vertices.sort_unstable();
+        MeshData {
+            points: self.points.iter().map(|p| p.to_array()).collect(),
+            tets: ids.iter().map(|&t| self.tets[t as usize]).collect(),
+            tet_regions: ids.iter().map(|&t| self.region[t as usize]).collect(),
+            triangles,
+            edges,
+            corners,
+            required_vertices,
+            tet_lines: Vec::new(),
+        }
+    }
+}
+
+/// A sorted face key packed into one integer so that sorting compares once.
+type FaceKeyPacked = u128;
+
+#[inline]
+fn pack(k: [u32; 3]) -> FaceKeyPacked {
+    ((k[0] as u128) << 64) | ((k[1] as u128) << 32) | k[2] as u128
+}
+
+#[inline]
+fn unpack(p: FaceKeyPacked) -> [u32; 3] {
+    [(p >> 64) as u32, (p >> 32) as u32, p as u32]
+}

@@ -1,0 +1,151 @@
+//! [`TetMesh::check`]: verifies every invariant of the store.
+
+use super::{edge_key, face_key, TetMesh, DEAD, NO_ADJ};
+use crate::geom::{orient3d_sign, Orientation, TET_EDGES, TET_FACES};
+use rayon::prelude::*;
+use std::collections::{HashMap, HashSet};
+
+/// An invariant that does not hold. Ids are the store's 0-based ids.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum CheckError {
+    /// Side tables disagree in length.
+    #[error("side tables have inconsistent lengths")]
+    Lengths,
+    /// A live tet names a vertex out of range or repeats one.
+    #[error("tet {0} has an invalid vertex list {1:?}")]
+    BadVertices(u32, [u32; 4]),
+    /// A live tet is not positively oriented.
+    #[error("tet {0} is inverted or flat ({1:?})")]
+    Orientation(u32, Orientation),
+    /// Adjacency is not mutual, points to a dead tet, or the faces differ.
+    #[error("adjacency of tet {0} face {1} is broken: {2}")]
+    Adjacency(u32, usize, &'static str),
+    /// The free list and the dead slots disagree.
+    #[error("free list inconsistent: {0}")]
+    FreeList(&'static str),
+    /// A boundary edge does not have exactly two boundary faces.
+    #[error("boundary edge {0:?} has {1} boundary faces (a manifold boundary has 2)")]
+    NonManifoldBoundary([u32; 2], usize),
+    /// A tag names a face, edge or vertex the mesh does not have.
+    #[error("tag inconsistent: {0}")]
+    Tag(String),
+}
+
+impl TetMesh {
+    /// Verifies all invariants: side-table lengths, free list, vertex lists,
+    /// exact positive orientation, mutual adjacency with equal and oppositely
+    /// oriented shared faces, a manifold boundary (each boundary edge in exactly
+    /// two boundary faces), and tags naming existing faces, edges and vertices.
+    pub fn check(&self) -> Result<(), CheckError> {
+        let n = self.tets.len();
+        if self.adj.len() != n
+            || self.generation.len() != n
+            || self.region.len() != n
+            || self.level.len() != n
+            || self.parent.len() != n
+        {
+            return Err(CheckError::Lengths);
+        }
+        let dead = self.tets.iter().filter(|v| v[0] == DEAD).count();
+        if dead != self.free.len() {
+            return Err(CheckError::FreeList("dead slot count differs from free list length"));
+        }
+        if self.free.iter().any(|&t| t as usize >= n || self.tets[t as usize][0] != DEAD) {
+            return Err(CheckError::FreeList("free list names a live or out-of-range slot"));
+        }
+        let np = self.points.len() as u32;
+        let first_err = (0..n as u32).into_par_iter().find_map_first(|t| {
+            let v = self.tets[t as usize];
+            if v[0] == DEAD {
+                return None;
+            }
+            if v.iter().any(|&x| x >= np)
+                || v[0] == v[1]
+                || v[0] == v[2]
+                || v[0] == v[3]
+                || v[1] == v[2]
+                || v[1] == v[3]
+                || v[2] == v[3]
+            {
+                return Some(CheckError::BadVertices(t, v));
+            }
+            let p = self.tet_points(t);
+            let o = orient3d_sign(p[0], p[1], p[2], p[3]);
+            if o != Orientation::Positive {
+                return Some(CheckError::Orientation(t, o));
+            }
+            for f in 0..4 {
+                let h = self.adj[t as usize][f];
+                if h == NO_ADJ {
+                    continue;
+                }
+                let (u, g) = ((h >> 2) as usize, (h & 3) as usize);
+                if u >= n || self.tets[u][0] == DEAD {
+                    return Some(CheckError::Adjacency(t, f, "neighbour is dead or out of range"));
+                }
+                if self.adj[u][g] != 4 * t + f as u32 {
+                    return Some(CheckError::Adjacency(t, f, "not mutual"));
+                }
+                let mine = self.face_vertices(t, f);
+                let theirs = self.face_vertices(u as u32, g);
+                if face_key(mine) != face_key(theirs) {
+                    return Some(CheckError::Adjacency(t, f, "the two faces have different vertices"));
+                }
+                // Opposite orientation: theirs must be a rotation of mine reversed.
+                let rev = [mine[0], mine[2], mine[1]];
+                let rotations = [rev, [rev[1], rev[2], rev[0]], [rev[2], rev[0], rev[1]]];
+                if !rotations.contains(&theirs) {
+                    return Some(CheckError::Adjacency(t, f, "shared face has the same orientation on both sides"));
+                }
+            }
+            None
+        });
+        if let Some(e) = first_err {
+            return Err(e);
+        }
+
+        // Boundary manifoldness and tag consistency need the face and edge sets.
+        let mut boundary_edge_count: HashMap<[u32; 2], usize> = HashMap::new();
+        for t in self.tet_ids() {
+            for f in 0..4 {
+                if self.adj[t as usize][f] == NO_ADJ {
+                    let fv = self.face_vertices(t, f);
+                    for (a, b) in [(fv[0], fv[1]), (fv[1], fv[2]), (fv[2], fv[0])] {
+                        *boundary_edge_count.entry(edge_key(a, b)).or_default() += 1;
+                    }
+                }
+            }
+        }
+        if let Some((e, &c)) = boundary_edge_count.iter().find(|(_, &c)| c != 2) {
+            return Err(CheckError::NonManifoldBoundary(*e, c));
+        }
+        if !self.face_markers.is_empty() {
+            let faces: HashSet<[u32; 3]> = self
+                .tet_ids()
+                .flat_map(|t| {
+                    let v = self.tets[t as usize];
+                    TET_FACES.iter().map(move |l| face_key([v[l[0]], v[l[1]], v[l[2]]]))
+                })
+                .collect();
+            if let Some(f) = self.face_markers.keys().find(|f| !faces.contains(*f)) {
+                return Err(CheckError::Tag(format!("marked face {f:?} is not a face of the mesh")));
+            }
+        }
+        if !self.feature_edges.is_empty() {
+            let edges: HashSet<[u32; 2]> = self
+                .tet_ids()
+                .flat_map(|t| {
+                    let v = self.tets[t as usize];
+                    TET_EDGES.iter().map(move |e| edge_key(v[e[0]], v[e[1]]))
+                })
+                .collect();
+            if let Some(e) = self.feature_edges.keys().find(|e| !edges.contains(*e)) {
+                return Err(CheckError::Tag(format!("feature edge {e:?} is not an edge of the mesh")));
+            }
+        }
+        if let Some(v) = self.corners.iter().chain(&self.required).find(|&&v| v >= np) {
+            return Err(CheckError::Tag(format!("tagged vertex {v} is out of range")));
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,448 @@
+//! The tetrahedral mesh store.
+//!
+//! Indexed, struct-of-arrays, `u32` ids, in the manner of mmg and geogram:
+//!
+//! * `points[v]`: coordinates; `tets[t]`: four vertex ids, positively oriented
+//!   (see [`crate::geom::predicates`]); face `i` of a tet is opposite its vertex `i`.
+//! * `adj[t][i] = 4*t' + j` when face `i` of `t` is face `j` of `t'`, or
+//!   [`NO_ADJ`] on the boundary. Every change goes through [`TetMesh::bond`],
+//!   which writes both sides.
+//! * Dead tets keep their slot (all four vertices [`DEAD`]) and go on a free list
+//!   that [`TetMesh::alloc_tet`] reuses; ids only move in [`TetMesh::compact`].
+//!   A generation counter per slot lets work queues detect stale ids.
+//! * Sparse tags live in side tables keyed by sorted vertex ids, so that local
+//!   operations never have to renumber them: face markers, feature edges,
+//!   corners and required vertices. `region`, `level` and `parent` are dense.
+
+mod build;
+mod check;
+mod compact;
+mod data;
+
+pub use build::{BuildReport, MeshError};
+pub use check::CheckError;
+pub use compact::Remap;
+pub use data::MeshData;
+
+use crate::geom::{TET_EDGES, TET_EDGE_OPPOSITE, TET_FACES};
+use glam::DVec3;
+use std::collections::{HashMap, HashSet};
+
+/// Adjacency value of a boundary face.
+pub const NO_ADJ: u32 = u32::MAX;
+/// Vertex id stored in every slot of a dead tet.
+pub const DEAD: u32 = u32::MAX;
+
+/// A face key: the three vertex ids sorted ascending.
+pub type FaceKey = [u32; 3];
+/// An edge key: the two vertex ids sorted ascending.
+pub type EdgeKey = [u32; 2];
+
+/// Sorted key of a triangle.
+#[inline]
+pub fn face_key(mut f: [u32; 3]) -> FaceKey {
+    if f[0] > f[1] {
+        f.swap(0, 1);
+    }
+    if f[1] > f[2] {
+        f.swap(1, 2);
+    }
+    if f[0] > f[1] {
+        f.swap(0, 1);
+    }
+    f
+}
+
+/// Sorted key of an edge.
+#[inline]
+pub fn edge_key(a: u32, b: u32) -> EdgeKey {
+    if a < b {
+        [a, b]
+    } else {
+        [b, a]
+    }
+}
+
+/// An indexed tetrahedral mesh with face adjacency and tag side tables.
+#[derive(Clone, Debug, Default)]
+pub struct TetMesh {
+    pub(crate) points: Vec<DVec3>,
+    pub(crate) tets: Vec<[u32; 4]>,
+    pub(crate) adj: Vec<[u32; 4]>,
+    pub(crate) generation: Vec<u32>,
+    pub(crate) free: Vec<u32>,
+    pub(crate) region: Vec<i32>,
+    pub(crate) level: Vec<u8>,
+    pub(crate) parent: Vec<u32>,
+    pub(crate) face_markers: HashMap<FaceKey, i32>,
+    pub(crate) feature_edges: HashMap<EdgeKey, i32>,
+    pub(crate) corners: HashSet<u32>,
+    pub(crate) required: HashSet<u32>,
+}
+
+impl TetMesh {
+    // ----- sizes and iteration -------------------------------------------------
+
+    /// Number of point slots (including points no tet references).
+    #[inline]
+    pub fn n_points(&self) -> usize {
+        self.points.len()
+    }
+
+    /// Number of tet slots, dead ones included.
+    #[inline]
+    pub fn n_tet_slots(&self) -> usize {
+        self.tets.len()
+    }
+
+    /// Number of live tets.
+    #[inline]
+    pub fn n_tets(&self) -> usize {
+        self.tets.len() - self.free.len()
+    }
+
+    /// Whether slot `t` holds a live tet.
+    #[inline]
+    pub fn is_alive(&self, t: u32) -> bool {
+        self.tets[t as usize][0] != DEAD
+    }
+
+    /// Ids of the live tets, ascending.
+    pub fn tet_ids(&self) -> impl Iterator<Item = u32> + '_ {
+        (0..self.tets.len() as u32).filter(move |&t| self.is_alive(t))
+    }
+
+    // ----- accessors (each asserts its id, as geogram does) --------------------
+
+    /// Coordinates of point `v`.
+    #[inline]
+    pub fn point(&self, v: u32) -> DVec3 {
+        debug_assert!((v as usize) < self.points.len(), "point {v} out of range");
+        self.points[v as usize]
+    }
+
+    /// All point coordinates.
+    #[inline]
+    pub fn points(&self) -> &[DVec3] {
+        &self.points
+    }
+
+    /// Moves point `v`. The caller is responsible for orientation (see
+    /// [`TetMesh::tets_stay_positive`]).
+    #[inline]
+    pub fn set_point(&mut self, v: u32, p: DVec3) {
+        self.points[v as usize] = p;
+    }
+
+    /// Appends a point and returns its id.
+    #[inline]
+    pub fn add_point(&mut self, p: DVec3) -> u32 {
+        self.points.push(p);
+        (self.points.len() - 1) as u32
+    }
+
+    /// The four vertex ids of tet `t`.
+    #[inline]
+    pub fn tet(&self, t: u32) -> [u32; 4] {
+        let v = self.tets[t as usize];
+        debug_assert!(v[0] != DEAD, "tet {t} is dead");
+        v
+    }
+
+    /// All tet slots (dead slots hold [`DEAD`]).
+    #[inline]
+    pub fn tet_slots(&self) -> &[[u32; 4]] {
+        &self.tets
+    }
+
+    /// The four corner points of tet `t`.
+    #[inline]
+    pub fn tet_points(&self, t: u32) -> [DVec3; 4] {
+        let v = self.tet(t);
+        [
+            self.points[v[0] as usize],
+            self.points[v[1] as usize],
+            self.points[v[2] as usize],
+            self.points[v[3] as usize],
+        ]
+    }
+
+    /// Adjacency of tet `t` (`4*t'+j` or [`NO_ADJ`] per face).
+    #[inline]
+    pub fn adj(&self, t: u32) -> [u32; 4] {
+        debug_assert!(self.is_alive(t), "tet {t} is dead");
+        self.adj[t as usize]
+    }
+
+    /// Generation counter of slot `t`: it changes whenever the slot is freed or
+    /// reused, so a queue that stored `(t, generation)` can tell a stale entry.
+    #[inline]
+    pub fn generation(&self, t: u32) -> u32 {
+        self.generation[t as usize]
+    }
+
+    /// Region id of tet `t`.
+    #[inline]
+    pub fn region(&self, t: u32) -> i32 {
+        self.region[t as usize]
+    }
+
+    /// Sets the region id of tet `t`.
+    #[inline]
+    pub fn set_region(&mut self, t: u32, r: i32) {
+        self.region[t as usize] = r;
+    }
+
+    /// Refinement level of tet `t` (0 for input tets).
+    #[inline]
+    pub fn level(&self, t: u32) -> u8 {
+        self.level[t as usize]
+    }
+
+    /// Sets the refinement level of tet `t`.
+    #[inline]
+    pub fn set_level(&mut self, t: u32, l: u8) {
+        self.level[t as usize] = l;
+    }
+
+    /// Input tet that tet `t` descends from (its own id for input tets).
+    #[inline]
+    pub fn parent(&self, t: u32) -> u32 {
+        self.parent[t as usize]
+    }
+
+    /// Sets the input tet that tet `t` descends from.
+    #[inline]
+    pub fn set_parent(&mut self, t: u32, p: u32) {
+        self.parent[t as usize] = p;
+    }
+
+    /// The outward-oriented vertex triple of face `f` of tet `t`.
+    #[inline]
+    pub fn face_vertices(&self, t: u32, f: usize) -> [u32; 3] {
+        let v = self.tet(t);
+        let l = TET_FACES[f];
+        [v[l[0]], v[l[1]], v[l[2]]]
+    }
+
+    /// Whether face `f` of tet `t` is on the boundary.
+    #[inline]
+    pub fn is_boundary_face(&self, t: u32, f: usize) -> bool {
+        self.adj[t as usize][f] == NO_ADJ
+    }
+
+    // ----- tags ----------------------------------------------------------------
+
+    /// Marker of the face with these vertices, if it has one.
+    pub fn face_marker(&self, f: [u32; 3]) -> Option<i32> {
+        self.face_markers.get(&face_key(f)).copied()
+    }
+
+    /// Sets (or with `None` removes) the marker of a face.
+    pub fn set_face_marker(&mut self, f: [u32; 3], m: Option<i32>) {
+        match m {
+            Some(m) => {
+                self.face_markers.insert(face_key(f), m);
+            }
+            None => {
+                self.face_markers.remove(&face_key(f));
+            }
+        }
+    }
+
+    /// All marked faces (sorted vertex keys) and their markers.
+    pub fn face_markers(&self) -> &HashMap<FaceKey, i32> {
+        &self.face_markers
+    }
+
+    /// Marker of feature edge `(a, b)`, if it is one.
+    pub fn feature_edge(&self, a: u32, b: u32) -> Option<i32> {
+        self.feature_edges.get(&edge_key(a, b)).copied()
+    }
+
+    /// Whether `(a, b)` is a feature edge.
+    pub fn is_feature_edge(&self, a: u32, b: u32) -> bool {
+        self.feature_edges.contains_key(&edge_key(a, b))
+    }
+
+    /// Tags (or with `None` untags) a feature edge.
+    pub fn set_feature_edge(&mut self, a: u32, b: u32, m: Option<i32>) {
+        match m {
+            Some(m) => {
+                self.feature_edges.insert(edge_key(a, b), m);
+            }
+            None => {
+                self.feature_edges.remove(&edge_key(a, b));
+            }
+        }
+    }
+
+    /// All feature edges and their markers.
+    pub fn feature_edges(&self) -> &HashMap<EdgeKey, i32> {
+        &self.feature_edges
+    }
+
+    /// Whether vertex `v` is a corner.
+    pub fn is_corner(&self, v: u32) -> bool {
+        self.corners.contains(&v)
+    }
+
+    /// Marks or unmarks vertex `v` as a corner.
+    pub fn set_corner(&mut self, v: u32, on: bool) {
+        if on {
+            self.corners.insert(v);
+        } else {
+            self.corners.remove(&v);
+        }
+    }
+
+    /// Corner vertices.
+    pub fn corners(&self) -> &HashSet<u32> {
+        &self.corners
+    }
+
+    /// Whether vertex `v` is required (must not move).
+    pub fn is_required(&self, v: u32) -> bool {
+        self.required.contains(&v)
+    }
+
+    /// Marks or unmarks vertex `v` as required.
+    pub fn set_required(&mut self, v: u32, on: bool) {
+        if on {
+            self.required.insert(v);
+        } else {
+            self.required.remove(&v);
+        }
+    }
+
+    /// Required vertices.
+    pub fn required_vertices(&self) -> &HashSet<u32> {
+        &self.required
+    }
+
+    // ----- topology edits ------------------------------------------------------
+
+    /// Links half-face `a = 4*t+i` with half-face `b = 4*t'+j` (both sides), or
+    /// marks `a` as boundary when `b` is [`NO_ADJ`].
+    #[inline]
+    pub fn bond(&mut self, a: u32, b: u32) {
+        debug_assert!(a != NO_ADJ);
+        self.adj[(a >> 2) as usize][(a & 3) as usize] = b;
+        if b != NO_ADJ {
+            self.adj[(b >> 2) as usize][(b & 3) as usize] = a;
+        }
+    }
+
+    /// Creates a tet (reusing a free slot if there is one) with no adjacency yet.
+    /// The caller must bond all four faces.
+    pub fn alloc_tet(&mut self, v: [u32; 4], region: i32) -> u32 {
+        debug_assert!(v.iter().all(|&x| (x as usize) < self.points.len()));
+        if let Some(t) = self.free.pop() {
+            let i = t as usize;
+            self.tets[i] = v;
+            self.adj[i] = [NO_ADJ; 4];
+            self.generation[i] = self.generation[i].wrapping_add(1);
+            self.region[i] = region;
+            self.level[i] = 0;
+            self.parent[i] = t;
+            t
+        } else {
+            let t = self.tets.len() as u32;
+            self.tets.push(v);
+            self.adj.push([NO_ADJ; 4]);
+            self.generation.push(0);
+            self.region.push(region);
+            self.level.push(0);
+            self.parent.push(t);
+            t
+        }
+    }
+
+    /// Replaces the vertices of a live tet in place (adjacency untouched).
+    #[inline]
+    pub fn set_tet(&mut self, t: u32, v: [u32; 4]) {
+        debug_assert!(self.is_alive(t));
+        self.tets[t as usize] = v;
+    }
+
+    /// Frees tet `t`; its neighbours still point to it until re-bonded.
+    pub fn kill_tet(&mut self, t: u32) {
+        let i = t as usize;
+        debug_assert!(self.tets[i][0] != DEAD, "tet {t} killed twice");
+        self.tets[i] = [DEAD; 4];
+        self.adj[i] = [NO_ADJ; 4];
+        self.generation[i] = self.generation[i].wrapping_add(1);
+        self.free.push(t);
+    }
+
+    /// Reserves room for `n` more tets and `p` more points.
+    pub fn reserve(&mut self, n: usize, p: usize) {
+        self.tets.reserve(n);
+        self.adj.reserve(n);
+        self.generation.reserve(n);
+        self.region.reserve(n);
+        self.level.reserve(n);
+        self.parent.reserve(n);
+        self.points.reserve(p);
+    }
+
+    // ----- derived topology ----------------------------------------------------
+
+    /// Local index of vertex `v` in tet `t`, if present.
+    #[inline]
+    pub fn local_index(&self, t: u32, v: u32) -> Option<usize> {
+        self.tets[t as usize].iter().position(|&x| x == v)
+    }
+
+    /// Walks around the edge `(tets[t][TET_EDGES[e][0]], tets[t][TET_EDGES[e][1]])`
+    /// through face adjacency and calls `visit` on each tet of its ring (starting
+    /// with `t`); stops early when `visit` returns `false`. Returns whether the
+    /// ring is closed (an interior edge) — meaningful only if not stopped early.
+    pub fn for_each_tet_around_edge(
+        &self,
+        t: u32,
+        e: usize,
+        mut visit: impl FnMut(u32) -> bool,
+    ) -> bool {
+        let v = self.tets[t as usize];
+        let (a, b) = (v[TET_EDGES[e][0]], v[TET_EDGES[e][1]]);
+        if !visit(t) {
+            return false;
+        }
+        // Leave t through one of the two faces holding the edge; if the walk hits
+        // the boundary, come back and go the other way.
+        for (pass, &first_exit) in TET_EDGE_OPPOSITE[e].iter().enumerate() {
+            let mut cur = t;
+            let mut exit = first_exit;
+            loop {
+                let n = self.adj[cur as usize][exit];
+                if n == NO_ADJ {
+                    break;
+                }
+                let (nt, entered) = (n >> 2, (n & 3) as usize);
+                if nt == t {
+                    // Closed ring: every tet already visited on the first pass.
+                    debug_assert_eq!(pass, 0);
+                    return true;
+                }
+                if !visit(nt) {
+                    return false;
+                }
+                let nv = self.tets[nt as usize];
+                // The next exit is the local vertex of nt that is neither a, b nor
+                // the one opposite the face we came in by.
+                exit = (0..4)
+                    .find(|&i| i != entered && nv[i] != a && nv[i] != b)
+                    .expect("edge ring broken: adjacency inconsistent");
+                cur = nt;
+            }
+        }
+        false
+    }
+
+    /// The two live-or-boundary neighbour relation as `(tet, face)` of half-face `h`.
+    #[inline]
+    pub fn half_face(h: u32) -> (u32, usize) {
+        (h >> 2, (h & 3) as usize)
+    }
+}

@@ -1,0 +1,5 @@
+//! Reports: statistics, histograms and JSON.
+
+pub mod stats;
+
+pub use stats::{Histogram, MeshStats};
