@@ -1,1 +1,37 @@
-fn main(){}
+//! `tetrefine` command line: a thin layer over the library.
+
+mod cli;
+
+use clap::{Parser, Subcommand};
+use std::process::ExitCode;
+
+/// Refine tetrahedral meshes for finite-element simulation and keep them well shaped.
+#[derive(Parser)]
+#[command(name = "tetrefine", version, about, propagate_version = true)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Print mesh statistics (the rows of Table 1 of the √3 paper and more).
+    Quality(cli::quality::Args),
+    /// Convert a mesh between formats, keeping regions, markers and features.
+    Convert(cli::convert::Args),
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Quality(a) => cli::quality::run(a),
+        Command::Convert(a) => cli::convert::run(a),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}

@@ -260,7 +260,11 @@ mod tests {
             ]);
             let a = dihedral_angles(&p);
             let lo = a.iter().cloned().fold(f64::INFINITY, f64::min).to_degrees();
-            let hi = a.iter().cloned().fold(f64::NEG_INFINITY, f64::max).to_degrees();
+            let hi = a
+                .iter()
+                .cloned()
+                .fold(f64::NEG_INFINITY, f64::max)
+                .to_degrees();
             let q = tet_quality(&p);
             assert!((q.min_dihedral_deg - lo).abs() < 1e-6);
             assert!((q.max_dihedral_deg - hi).abs() < 1e-6);

@@ -142,7 +142,9 @@ pub fn read(path: &Path) -> Result<MeshData, IoError> {
                     let n = count(&mut tok, "entry count")?;
                     for _ in 0..n * w {
                         if tok.next().is_none() {
-                            return Err(tok.error(format!("file ends inside section {other} (truncated?)")));
+                            return Err(
+                                tok.error(format!("file ends inside section {other} (truncated?)"))
+                            );
                         }
                     }
                 }
@@ -160,7 +162,10 @@ pub fn read(path: &Path) -> Result<MeshData, IoError> {
     }
     let _ = saw_end; // End is optional in practice (many writers omit it).
     if data.tets.is_empty() {
-        return Err(IoError::file(path, "no Tetrahedra section: not a volume mesh"));
+        return Err(IoError::file(
+            path,
+            "no Tetrahedra section: not a volume mesh",
+        ));
     }
     data.edges = raw_edges;
     let _ = ridges; // every listed edge is already a feature
@@ -191,7 +196,11 @@ pub fn write(path: &Path, mesh: &TetMesh) -> Result<(), IoError> {
 /// Writes plain mesh data as Medit `.mesh` ASCII.
 pub fn write_data(path: &Path, d: &MeshData) -> Result<(), IoError> {
     write_atomic(path, |w| {
-        writeln!(w, "MeshVersionFormatted 2\n\nDimension 3\n\nVertices\n{}", d.points.len())?;
+        writeln!(
+            w,
+            "MeshVersionFormatted 2\n\nDimension 3\n\nVertices\n{}",
+            d.points.len()
+        )?;
         for p in &d.points {
             writeln!(w, "{:?} {:?} {:?} 0", p[0], p[1], p[2])?;
         }
@@ -225,7 +234,15 @@ pub fn write_data(path: &Path, d: &MeshData) -> Result<(), IoError> {
         }
         writeln!(w, "\nTetrahedra\n{}", d.tets.len())?;
         for (t, v) in d.tets.iter().enumerate() {
-            writeln!(w, "{} {} {} {} {}", v[0] + 1, v[1] + 1, v[2] + 1, v[3] + 1, d.region(t))?;
+            writeln!(
+                w,
+                "{} {} {} {} {}",
+                v[0] + 1,
+                v[1] + 1,
+                v[2] + 1,
+                v[3] + 1,
+                d.region(t)
+            )?;
         }
         writeln!(w, "\nEnd")
     })

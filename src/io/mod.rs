@@ -92,8 +92,10 @@ impl Format {
                 let mut head = [0u8; 64];
                 let n = {
                     use std::io::Read;
-                    let mut f = File::open(path).map_err(|e| IoError::file(path, open_message(&e)))?;
-                    f.read(&mut head).map_err(|e| IoError::file(path, e.to_string()))?
+                    let mut f =
+                        File::open(path).map_err(|e| IoError::file(path, open_message(&e)))?;
+                    f.read(&mut head)
+                        .map_err(|e| IoError::file(path, e.to_string()))?
                 };
                 let text = String::from_utf8_lossy(&head[..n]);
                 let first = text.split_whitespace().next().unwrap_or("");
@@ -103,7 +105,10 @@ impl Format {
                     Ok(Format::Gmsh)
                 }
             }
-            "" => Err(IoError::file(path, "has no extension; use .mesh, .msh, .vtu, .node or .ele")),
+            "" => Err(IoError::file(
+                path,
+                "has no extension; use .mesh, .msh, .vtu, .node or .ele",
+            )),
             other => Err(IoError::file(
                 path,
                 format!("unknown mesh extension '.{other}'; use .mesh, .msh, .vtu, .node or .ele"),
@@ -144,7 +149,10 @@ pub(crate) fn read_bytes(path: &Path) -> Result<Vec<u8>, IoError> {
 pub fn read_mesh(path: &Path) -> Result<MeshData, IoError> {
     match Format::for_reading(path)? {
         Format::Medit => medit::read(path),
-        other => Err(IoError::file(path, format!("reading {other:?} is not supported yet"))),
+        other => Err(IoError::file(
+            path,
+            format!("reading {other:?} is not supported yet"),
+        )),
     }
 }
 
@@ -162,7 +170,10 @@ pub fn load_mesh(path: &Path) -> Result<(TetMesh, crate::mesh::BuildReport), IoE
 pub fn write_mesh(path: &Path, mesh: &TetMesh) -> Result<(), IoError> {
     match Format::for_writing(path)? {
         Format::Medit => medit::write(path, mesh),
-        other => Err(IoError::file(path, format!("writing {other:?} is not supported yet"))),
+        other => Err(IoError::file(
+            path,
+            format!("writing {other:?} is not supported yet"),
+        )),
     }
 }
 
@@ -172,7 +183,10 @@ pub fn write_atomic(
     path: &Path,
     body: impl FnOnce(&mut BufWriter<File>) -> std::io::Result<()>,
 ) -> Result<(), IoError> {
-    let dir = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    let dir = path
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
     let name = path
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())

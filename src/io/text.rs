@@ -142,7 +142,15 @@ fn shorten(s: &str) -> String {
 /// The file as UTF-8 text, or a clear error for binary garbage.
 pub(crate) fn as_text<'a>(path: &Path, bytes: &'a [u8]) -> Result<&'a str, IoError> {
     std::str::from_utf8(bytes).map_err(|e| {
-        let line = bytes[..e.valid_up_to()].iter().filter(|&&c| c == b'\n').count() + 1;
-        IoError::at(path, line, "not a text file (invalid UTF-8): expected an ASCII mesh")
+        let line = bytes[..e.valid_up_to()]
+            .iter()
+            .filter(|&&c| c == b'\n')
+            .count()
+            + 1;
+        IoError::at(
+            path,
+            line,
+            "not a text file (invalid UTF-8): expected an ASCII mesh",
+        )
     })
 }

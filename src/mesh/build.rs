@@ -192,7 +192,13 @@ impl TetMesh {
                         n_points,
                     });
                 }
-                if v[0] == v[1] || v[0] == v[2] || v[0] == v[3] || v[1] == v[2] || v[1] == v[3] || v[2] == v[3] {
+                if v[0] == v[1]
+                    || v[0] == v[2]
+                    || v[0] == v[3]
+                    || v[1] == v[2]
+                    || v[1] == v[3]
+                    || v[2] == v[3]
+                {
                     return Err(MeshError::RepeatedVertex {
                         at: at(t),
                         vertices: v.map(|x| x as u64 + 1),
@@ -240,7 +246,10 @@ impl TetMesh {
             .flat_map_iter(|(t, v)| {
                 (0..4).map(move |f| {
                     let l = TET_FACES[f];
-                    (pack(face_key([v[l[0]], v[l[1]], v[l[2]]])), (4 * t + f) as u32)
+                    (
+                        pack(face_key([v[l[0]], v[l[1]], v[l[2]]])),
+                        (4 * t + f) as u32,
+                    )
                 })
             })
             .collect();
@@ -380,7 +389,11 @@ impl TetMesh {
             let faces: HashSet<[u32; 3]> = self
                 .tets
                 .iter()
-                .flat_map(|v| TET_FACES.iter().map(move |l| face_key([v[l[0]], v[l[1]], v[l[2]]])))
+                .flat_map(|v| {
+                    TET_FACES
+                        .iter()
+                        .map(move |l| face_key([v[l[0]], v[l[1]], v[l[2]]]))
+                })
                 .collect();
             for &(f, m) in &data.triangles {
                 let k = face_key(f);
@@ -395,7 +408,11 @@ impl TetMesh {
             let edges: HashSet<[u32; 2]> = self
                 .tets
                 .iter()
-                .flat_map(|v| crate::geom::TET_EDGES.iter().map(move |e| edge_key(v[e[0]], v[e[1]])))
+                .flat_map(|v| {
+                    crate::geom::TET_EDGES
+                        .iter()
+                        .map(move |e| edge_key(v[e[0]], v[e[1]]))
+                })
                 .collect();
             let mut tagged = HashMap::new();
             for &([a, b], m) in &data.edges {
@@ -438,7 +455,8 @@ impl TetMesh {
             }
         }
         triangles.sort_unstable_by_key(|(f, m)| (face_key(*f), *m));
-        let mut edges: Vec<([u32; 2], i32)> = self.feature_edges.iter().map(|(k, &m)| (*k, m)).collect();
+        let mut edges: Vec<([u32; 2], i32)> =
+            self.feature_edges.iter().map(|(k, &m)| (*k, m)).collect();
         edges.sort_unstable();
         let mut corners: Vec<u32> = self.corners.iter().copied().collect();
         corners.sort_unstable();

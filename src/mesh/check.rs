@@ -48,10 +48,18 @@ impl TetMesh {
         }
         let dead = self.tets.iter().filter(|v| v[0] == DEAD).count();
         if dead != self.free.len() {
-            return Err(CheckError::FreeList("dead slot count differs from free list length"));
+            return Err(CheckError::FreeList(
+                "dead slot count differs from free list length",
+            ));
         }
-        if self.free.iter().any(|&t| t as usize >= n || self.tets[t as usize][0] != DEAD) {
-            return Err(CheckError::FreeList("free list names a live or out-of-range slot"));
+        if self
+            .free
+            .iter()
+            .any(|&t| t as usize >= n || self.tets[t as usize][0] != DEAD)
+        {
+            return Err(CheckError::FreeList(
+                "free list names a live or out-of-range slot",
+            ));
         }
         let np = self.points.len() as u32;
         let first_err = (0..n as u32).into_par_iter().find_map_first(|t| {
@@ -81,7 +89,11 @@ impl TetMesh {
                 }
                 let (u, g) = ((h >> 2) as usize, (h & 3) as usize);
                 if u >= n || self.tets[u][0] == DEAD {
-                    return Some(CheckError::Adjacency(t, f, "neighbour is dead or out of range"));
+                    return Some(CheckError::Adjacency(
+                        t,
+                        f,
+                        "neighbour is dead or out of range",
+                    ));
                 }
                 if self.adj[u][g] != 4 * t + f as u32 {
                     return Some(CheckError::Adjacency(t, f, "not mutual"));
@@ -89,13 +101,21 @@ impl TetMesh {
                 let mine = self.face_vertices(t, f);
                 let theirs = self.face_vertices(u as u32, g);
                 if face_key(mine) != face_key(theirs) {
-                    return Some(CheckError::Adjacency(t, f, "the two faces have different vertices"));
+                    return Some(CheckError::Adjacency(
+                        t,
+                        f,
+                        "the two faces have different vertices",
+                    ));
                 }
                 // Opposite orientation: theirs must be a rotation of mine reversed.
                 let rev = [mine[0], mine[2], mine[1]];
                 let rotations = [rev, [rev[1], rev[2], rev[0]], [rev[2], rev[0], rev[1]]];
                 if !rotations.contains(&theirs) {
-                    return Some(CheckError::Adjacency(t, f, "shared face has the same orientation on both sides"));
+                    return Some(CheckError::Adjacency(
+                        t,
+                        f,
+                        "shared face has the same orientation on both sides",
+                    ));
                 }
             }
             None
@@ -124,11 +144,15 @@ impl TetMesh {
                 .tet_ids()
                 .flat_map(|t| {
                     let v = self.tets[t as usize];
-                    TET_FACES.iter().map(move |l| face_key([v[l[0]], v[l[1]], v[l[2]]]))
+                    TET_FACES
+                        .iter()
+                        .map(move |l| face_key([v[l[0]], v[l[1]], v[l[2]]]))
                 })
                 .collect();
             if let Some(f) = self.face_markers.keys().find(|f| !faces.contains(*f)) {
-                return Err(CheckError::Tag(format!("marked face {f:?} is not a face of the mesh")));
+                return Err(CheckError::Tag(format!(
+                    "marked face {f:?} is not a face of the mesh"
+                )));
             }
         }
         if !self.feature_edges.is_empty() {
@@ -140,11 +164,20 @@ impl TetMesh {
                 })
                 .collect();
             if let Some(e) = self.feature_edges.keys().find(|e| !edges.contains(*e)) {
-                return Err(CheckError::Tag(format!("feature edge {e:?} is not an edge of the mesh")));
+                return Err(CheckError::Tag(format!(
+                    "feature edge {e:?} is not an edge of the mesh"
+                )));
             }
         }
-        if let Some(v) = self.corners.iter().chain(&self.required).find(|&&v| v >= np) {
-            return Err(CheckError::Tag(format!("tagged vertex {v} is out of range")));
+        if let Some(v) = self
+            .corners
+            .iter()
+            .chain(&self.required)
+            .find(|&&v| v >= np)
+        {
+            return Err(CheckError::Tag(format!(
+                "tagged vertex {v} is out of range"
+            )));
         }
         Ok(())
     }

@@ -93,8 +93,18 @@ impl TetMesh {
             .filter(|(k, _)| k.iter().all(|&v| pm(v) != DEAD))
             .map(|(k, m)| (super::edge_key(pm(k[0]), pm(k[1])), m))
             .collect::<HashMap<_, _>>();
-        self.corners = self.corners.iter().map(|&v| pm(v)).filter(|&v| v != DEAD).collect::<HashSet<_>>();
-        self.required = self.required.iter().map(|&v| pm(v)).filter(|&v| v != DEAD).collect::<HashSet<_>>();
+        self.corners = self
+            .corners
+            .iter()
+            .map(|&v| pm(v))
+            .filter(|&v| v != DEAD)
+            .collect::<HashSet<_>>();
+        self.required = self
+            .required
+            .iter()
+            .map(|&v| pm(v))
+            .filter(|&v| v != DEAD)
+            .collect::<HashSet<_>>();
         Remap {
             points: point_map,
             tets: tet_map,

@@ -182,7 +182,10 @@ impl Acc {
 impl MeshStats {
     /// Statistics with the default histogram (1° bins over 0–71°).
     pub fn compute(mesh: &TetMesh) -> MeshStats {
-        Self::compute_with(mesh, Histogram::new(0.0, DEFAULT_HIST_MAX_DEG, DEFAULT_BINS))
+        Self::compute_with(
+            mesh,
+            Histogram::new(0.0, DEFAULT_HIST_MAX_DEG, DEFAULT_BINS),
+        )
     }
 
     /// Statistics, filling the given (empty) histogram bins.
@@ -287,7 +290,10 @@ impl MeshStats {
             },
             inverted: acc.inverted,
             volume: acc.volume,
-            regions: regions.into_iter().map(|(k, v)| (k.to_string(), v)).collect(),
+            regions: regions
+                .into_iter()
+                .map(|(k, v)| (k.to_string(), v))
+                .collect(),
             histogram,
         }
     }
