@@ -9,6 +9,7 @@ pub mod geom;
 pub mod io;
 pub mod mesh;
 pub mod report;
+pub mod surface;
 
 pub use mesh::{MeshData, TetMesh};
 pub use report::MeshStats;

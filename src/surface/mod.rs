@@ -1,0 +1,6 @@
+//! Secondary module: polygon-mesh subdivision schemes of the seed papers and
+//! the √3 stencils shared with the tetrahedral step.
+
+pub mod polymesh;
+
+pub use polymesh::PolyMesh;
