@@ -8,7 +8,10 @@
 pub mod geom;
 pub mod io;
 pub mod mesh;
+pub mod ops;
+pub mod refine;
 pub mod report;
+pub mod smooth;
 pub mod surface;
 
 pub use mesh::{MeshData, TetMesh};

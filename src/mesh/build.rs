@@ -348,6 +348,7 @@ impl TetMesh {
             adj,
             ..Default::default()
         };
+        mesh.rebuild_v2t();
         let mut report = BuildReport {
             reoriented,
             unreferenced_points,

@@ -79,6 +79,7 @@ impl TetMesh {
             }
         }
         self.points.truncate(pw);
+        self.rebuild_v2t();
 
         let pm = |v: u32| point_map[v as usize];
         self.face_markers = self

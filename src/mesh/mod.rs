@@ -78,6 +78,10 @@ pub struct TetMesh {
     pub(crate) feature_edges: HashMap<EdgeKey, i32>,
     pub(crate) corners: HashSet<u32>,
     pub(crate) required: HashSet<u32>,
+    /// One live tet holding each vertex (`DEAD` for unused points). Every
+    /// operation re-creates tets over all vertices of the cavity it removes, and
+    /// `alloc_tet`/`set_tet` write this entry, so it never goes stale.
+    pub(crate) v2t: Vec<u32>,
 }
 
 impl TetMesh {
@@ -138,7 +142,17 @@ impl TetMesh {
     #[inline]
     pub fn add_point(&mut self, p: DVec3) -> u32 {
         self.points.push(p);
+        self.v2t.push(DEAD);
         (self.points.len() - 1) as u32
+    }
+
+    /// Removes point `v` if it is the last one and no tet uses it (undoing an
+    /// `add_point` of a refused operation).
+    pub fn pop_unused_point(&mut self, v: u32) {
+        if v as usize + 1 == self.points.len() && self.v2t[v as usize] == DEAD {
+            self.points.pop();
+            self.v2t.pop();
+        }
     }
 
     /// The four vertex ids of tet `t`.
@@ -337,6 +351,14 @@ impl TetMesh {
     /// The caller must bond all four faces.
     pub fn alloc_tet(&mut self, v: [u32; 4], region: i32) -> u32 {
         debug_assert!(v.iter().all(|&x| (x as usize) < self.points.len()));
+        let t = self.alloc_slot(v, region);
+        for x in v {
+            self.v2t[x as usize] = t;
+        }
+        t
+    }
+
+    fn alloc_slot(&mut self, v: [u32; 4], region: i32) -> u32 {
         if let Some(t) = self.free.pop() {
             let i = t as usize;
             self.tets[i] = v;
@@ -363,6 +385,9 @@ impl TetMesh {
     pub fn set_tet(&mut self, t: u32, v: [u32; 4]) {
         debug_assert!(self.is_alive(t));
         self.tets[t as usize] = v;
+        for x in v {
+            self.v2t[x as usize] = t;
+        }
     }
 
     /// Frees tet `t`; its neighbours still point to it until re-bonded.
@@ -384,6 +409,7 @@ impl TetMesh {
         self.level.reserve(n);
         self.parent.reserve(n);
         self.points.reserve(p);
+        self.v2t.reserve(p);
     }
 
     // ----- derived topology ----------------------------------------------------
@@ -440,9 +466,59 @@ impl TetMesh {
         false
     }
 
-    /// The two live-or-boundary neighbour relation as `(tet, face)` of half-face `h`.
+    /// Splits a half-face id `4*t+f` into `(t, f)`.
     #[inline]
     pub fn half_face(h: u32) -> (u32, usize) {
         (h >> 2, (h & 3) as usize)
+    }
+
+    /// A live tet holding vertex `v`, or `None` if no tet uses it.
+    #[inline]
+    pub fn tet_of_vertex(&self, v: u32) -> Option<u32> {
+        let t = self.v2t[v as usize];
+        (t != DEAD).then_some(t)
+    }
+
+    /// Rebuilds the vertex → tet table from scratch.
+    pub fn rebuild_v2t(&mut self) {
+        self.v2t.clear();
+        self.v2t.resize(self.points.len(), DEAD);
+        for (t, v) in self.tets.iter().enumerate() {
+            if v[0] != DEAD {
+                for &x in v {
+                    self.v2t[x as usize] = t as u32;
+                }
+            }
+        }
+    }
+
+    /// The tets around vertex `v` (its ball), found by walking face adjacency
+    /// from one incident tet; appended to `out` (cleared first).
+    pub fn ball(&self, v: u32, out: &mut Vec<u32>) {
+        out.clear();
+        let Some(start) = self.tet_of_vertex(v) else {
+            return;
+        };
+        debug_assert!(self.tets[start as usize].contains(&v), "v2t stale for {v}");
+        out.push(start);
+        let mut i = 0;
+        while i < out.len() {
+            let t = out[i];
+            i += 1;
+            let tv = self.tets[t as usize];
+            for f in 0..4 {
+                // Only faces that contain v lead to other tets of the ball.
+                if tv[f] == v {
+                    continue;
+                }
+                let h = self.adj[t as usize][f];
+                if h != NO_ADJ {
+                    let n = h >> 2;
+                    if !out.contains(&n) {
+                        out.push(n);
+                    }
+                }
+            }
+        }
     }
 }

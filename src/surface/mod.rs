@@ -2,5 +2,6 @@
 //! the √3 stencils shared with the tetrahedral step.
 
 pub mod polymesh;
+pub mod sqrt3;
 
 pub use polymesh::PolyMesh;

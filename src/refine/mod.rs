@@ -1,0 +1,196 @@
+//! The √3 tetrahedral subdivision step of Burkhart, Hamann and Umlauf,
+//! "Adaptive and feature-preserving subdivision for high-quality tetrahedral
+//! meshes" (Computer Graphics Forum 2010), §3–4, as named phases:
+//!
+//! 1. `split` — 1-4 split of every selected tet at its barycentre;
+//! 2. `flip` — 2-3 flip of every old interior face whose two tets were split;
+//! 3. `boundary-split` — 1-3 split of every boundary face of a split tet;
+//! 4. `boundary-flip` — every old boundary edge between two split faces is
+//!    removed (m tets → 2m − 2), so the new boundary edge joins two face
+//!    barycentres: the triangle √3 flip;
+//! 5. `boundary-smooth` — the √3 stencils of [`crate::surface::sqrt3`] move the
+//!    boundary points; a move that would invert a tet is shortened or skipped;
+//! 6. `optimize` — interior edge removal and vertex smoothing
+//!    ([`crate::smooth::improve`]).
+
+pub mod parents;
+pub mod step;
+
+pub use parents::locate_parents;
+pub use step::{refine, refine_step};
+
+use crate::smooth::ImproveReport;
+use crate::surface::sqrt3::Sqrt3Rule;
+use serde::Serialize;
+use std::fmt;
+use std::str::FromStr;
+
+/// A phase of the step, in the paper's order.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum Phase {
+    /// 1-4 splits.
+    Split,
+    /// 2-3 flips of old interior faces.
+    Flip,
+    /// 1-3 splits of boundary faces.
+    BoundarySplit,
+    /// √3 flips of old boundary edges by edge removal.
+    BoundaryFlip,
+    /// √3 stencils on the boundary points.
+    BoundarySmooth,
+    /// Edge removal and vertex smoothing.
+    Optimize,
+}
+
+impl Phase {
+    /// All phases in order.
+    pub const ALL: [Phase; 6] = [
+        Phase::Split,
+        Phase::Flip,
+        Phase::BoundarySplit,
+        Phase::BoundaryFlip,
+        Phase::BoundarySmooth,
+        Phase::Optimize,
+    ];
+
+    /// The phase's name on the command line and in reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            Phase::Split => "split",
+            Phase::Flip => "flip",
+            Phase::BoundarySplit => "boundary-split",
+            Phase::BoundaryFlip => "boundary-flip",
+            Phase::BoundarySmooth => "boundary-smooth",
+            Phase::Optimize => "optimize",
+        }
+    }
+}
+
+impl fmt::Display for Phase {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl FromStr for Phase {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Phase, String> {
+        Phase::ALL
+            .iter()
+            .copied()
+            .find(|p| p.name() == s)
+            .ok_or_else(|| {
+                format!(
+                    "unknown phase '{s}'; one of {}",
+                    Phase::ALL.map(|p| p.name()).join(", ")
+                )
+            })
+    }
+}
+
+/// The boundary rule of step 5.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum BoundaryRule {
+    /// Labsik–Greiner interpolating √3: old boundary points stay.
+    #[default]
+    Interpolating,
+    /// Kobbelt's approximating √3.
+    Approximating,
+    /// New boundary points on the old surface (face barycentres), old ones fixed.
+    Linear,
+}
+
+impl BoundaryRule {
+    /// The shared surface stencil for this rule.
+    pub fn sqrt3_rule(self) -> Sqrt3Rule {
+        match self {
+            BoundaryRule::Interpolating => Sqrt3Rule::Interpolating,
+            BoundaryRule::Approximating => Sqrt3Rule::Approximating,
+            BoundaryRule::Linear => Sqrt3Rule::Linear,
+        }
+    }
+}
+
+impl FromStr for BoundaryRule {
+    type Err = String;
+    fn from_str(s: &str) -> Result<BoundaryRule, String> {
+        match s {
+            "interpolating" => Ok(BoundaryRule::Interpolating),
+            "approximating" => Ok(BoundaryRule::Approximating),
+            "linear" => Ok(BoundaryRule::Linear),
+            _ => Err(format!(
+                "unknown boundary rule '{s}'; one of interpolating, approximating, linear"
+            )),
+        }
+    }
+}
+
+/// Options of a refinement step.
+#[derive(Clone, Debug)]
+pub struct RefineOptions {
+    /// Boundary rule.
+    pub boundary: BoundaryRule,
+    /// Passes of the optimize phase (0 = skip it).
+    pub opt_passes: usize,
+    /// Quality (min sine) below which vertices are smoothed.
+    pub threshold: f64,
+    /// Stop after this phase (for inspection and tests).
+    pub stop_after: Option<Phase>,
+    /// Per tet slot: is it selected for splitting? `None` = every tet.
+    pub selection: Option<Vec<bool>>,
+}
+
+impl Default for RefineOptions {
+    fn default() -> Self {
+        RefineOptions {
+            boundary: BoundaryRule::Interpolating,
+            opt_passes: 3,
+            threshold: 0.3,
+            stop_after: None,
+            selection: None,
+        }
+    }
+}
+
+/// Time and size after one phase.
+#[derive(Clone, Debug, Serialize)]
+pub struct PhaseReport {
+    /// Phase name.
+    pub name: &'static str,
+    /// Live tets after the phase.
+    pub tets: usize,
+    /// Wall time of the phase.
+    pub seconds: f64,
+}
+
+/// What one step did.
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct StepReport {
+    /// Per phase, in order (only the phases that ran).
+    pub phases: Vec<PhaseReport>,
+    /// Tets split 1-4.
+    pub split: usize,
+    /// Interior faces flipped 2-3.
+    pub flipped: usize,
+    /// 2-3 flips refused (segment between the barycentres misses the face, or
+    /// the face separates regions or carries a marker).
+    pub refused_flips: usize,
+    /// Barycentres moved towards a shared face so that its 2-3 flip is valid.
+    pub moved_barycentres: usize,
+    /// Boundary faces split 1-3.
+    pub boundary_split: usize,
+    /// Old boundary edges flipped.
+    pub boundary_flipped: usize,
+    /// Boundary edge flips refused (would invert, marker change, feature).
+    pub refused_boundary_flips: usize,
+    /// Boundary points moved the full way.
+    pub full_moves: usize,
+    /// Boundary point moves shortened to avoid an inverted tet.
+    pub shortened_moves: usize,
+    /// Boundary point moves skipped entirely.
+    pub skipped_moves: usize,
+    /// The optimize phase.
+    pub improve: ImproveReport,
+    /// Wall time of the whole step.
+    pub seconds: f64,
+}

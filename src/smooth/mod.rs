@@ -1,0 +1,66 @@
+//! Mesh improvement: vertex smoothing (Laplacian, then optimization-based) and
+//! interior edge removal, as in §3.2 of the seed paper.
+//!
+//! The objective everywhere is the paper's quality: the minimum signed sine of
+//! the dihedral angles of a tet, and for a vertex the minimum over its ball.
+
+pub mod improve;
+pub mod laplacian;
+pub mod optimize;
+
+pub use improve::{fixed_vertices, improve, ImproveOptions, ImproveReport};
+
+use crate::geom::{orient3d, tet_min_sine};
+use crate::mesh::TetMesh;
+use glam::DVec3;
+
+/// Smallest quality over the tets of `ball` if vertex `v` stood at `x`.
+pub fn ball_quality_at(mesh: &TetMesh, v: u32, ball: &[u32], x: DVec3) -> f64 {
+    let mut q = f64::INFINITY;
+    for &t in ball {
+        let tv = mesh.tet(t);
+        let mut p = mesh.tet_points(t);
+        for i in 0..4 {
+            if tv[i] == v {
+                p[i] = x;
+            }
+        }
+        q = q.min(tet_min_sine(&p));
+    }
+    q
+}
+
+/// Smallest quality over the tets of `ball` as they stand.
+pub fn ball_quality(mesh: &TetMesh, ball: &[u32]) -> f64 {
+    ball.iter()
+        .map(|&t| tet_min_sine(&mesh.tet_points(t)))
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// Whether every tet of `ball` stays positively oriented (exact predicate) with
+/// vertex `v` at `x`.
+pub fn ball_stays_positive(mesh: &TetMesh, v: u32, ball: &[u32], x: DVec3) -> bool {
+    ball.iter().all(|&t| {
+        let tv = mesh.tet(t);
+        let mut p = mesh.tet_points(t);
+        for i in 0..4 {
+            if tv[i] == v {
+                p[i] = x;
+            }
+        }
+        orient3d(p[0], p[1], p[2], p[3]) > 0.0
+    })
+}
+
+/// The distinct vertices adjacent to `v` (sharing a tet with it), appended to
+/// `out` (cleared first).
+pub fn vertex_neighbours(mesh: &TetMesh, v: u32, ball: &[u32], out: &mut Vec<u32>) {
+    out.clear();
+    for &t in ball {
+        for x in mesh.tet(t) {
+            if x != v && !out.contains(&x) {
+                out.push(x);
+            }
+        }
+    }
+}

@@ -1,0 +1,170 @@
+//! Optimization-based smoothing: move a vertex to raise the minimum quality of
+//! its ball (the non-smooth max–min problem of Freitag, Jones and Plassmann,
+//! "An efficient parallel algorithm for mesh smoothing", 1995, and Freitag's
+//! thesis 1997).
+//!
+//! Each iteration takes the tets whose quality is within a small tolerance of
+//! the minimum (the active set), estimates their quality gradients with
+//! respect to the vertex by central differences, and searches along the
+//! direction that raises all of them (the minimum-norm point of the convex hull
+//! of the active gradients, found by a few Frank–Wolfe/Gilbert steps). A step
+//! is accepted only if the ball's minimum rises and no tet inverts (exact
+//! predicate); otherwise it is halved, a few times, and then the search stops.
+
+use super::{ball_quality_at, ball_stays_positive};
+use crate::geom::tet_min_sine;
+use crate::mesh::TetMesh;
+use glam::DVec3;
+
+/// Tuning of the optimiser.
+#[derive(Clone, Copy, Debug)]
+pub struct OptimizeParams {
+    /// Outer iterations.
+    pub iterations: usize,
+    /// Qualities within this of the minimum are active.
+    pub active_tol: f64,
+    /// Halvings of a rejected step before giving up.
+    pub halvings: usize,
+}
+
+impl Default for OptimizeParams {
+    fn default() -> Self {
+        OptimizeParams {
+            iterations: 12,
+            active_tol: 1e-3,
+            halvings: 10,
+        }
+    }
+}
+
+fn tet_quality_with(mesh: &TetMesh, t: u32, v: u32, x: DVec3) -> f64 {
+    let tv = mesh.tet(t);
+    let mut p = mesh.tet_points(t);
+    for i in 0..4 {
+        if tv[i] == v {
+            p[i] = x;
+        }
+    }
+    tet_min_sine(&p)
+}
+
+/// Minimum-norm point of the convex hull of `g` (a few Gilbert iterations):
+/// a direction along which all active qualities rise, if one exists.
+fn min_norm_in_hull(g: &[DVec3]) -> DVec3 {
+    let mut x = g[0];
+    for _ in 0..32 {
+        // Vertex minimising <x, g_i>.
+        let (mut best, mut bi) = (f64::INFINITY, 0);
+        for (i, gi) in g.iter().enumerate() {
+            let d = x.dot(*gi);
+            if d < best {
+                best = d;
+                bi = i;
+            }
+        }
+        let d = g[bi] - x;
+        let dd = d.length_squared();
+        if dd < 1e-30 {
+            break;
+        }
+        let step = (-x.dot(d) / dd).clamp(0.0, 1.0);
+        if step <= 1e-12 {
+            break;
+        }
+        x += step * d;
+    }
+    x
+}
+
+/// Optimises the position of `v`; returns the new minimum quality if it moved.
+pub fn optimize_vertex(
+    mesh: &mut TetMesh,
+    v: u32,
+    ball: &[u32],
+    params: &OptimizeParams,
+) -> Option<f64> {
+    let x0 = mesh.point(v);
+    // A length scale for differences and steps: mean distance to the ball's
+    // other vertices.
+    let mut scale = 0.0;
+    let mut n = 0;
+    for &t in ball {
+        for u in mesh.tet(t) {
+            if u != v {
+                scale += (mesh.point(u) - x0).length();
+                n += 1;
+            }
+        }
+    }
+    if n == 0 {
+        return None;
+    }
+    scale /= n as f64;
+    let h = 1e-6 * scale;
+    let mut x = x0;
+    let mut q = ball_quality_at(mesh, v, ball, x);
+    let start = q;
+    let mut qs: Vec<f64> = Vec::with_capacity(ball.len());
+    let mut grads: Vec<DVec3> = Vec::new();
+    for _ in 0..params.iterations {
+        qs.clear();
+        qs.extend(ball.iter().map(|&t| tet_quality_with(mesh, t, v, x)));
+        grads.clear();
+        for (i, &t) in ball.iter().enumerate() {
+            if qs[i] > q + params.active_tol {
+                continue;
+            }
+            let mut g = DVec3::ZERO;
+            for axis in 0..3 {
+                let mut e = DVec3::ZERO;
+                e[axis] = h;
+                g[axis] = (tet_quality_with(mesh, t, v, x + e)
+                    - tet_quality_with(mesh, t, v, x - e))
+                    / (2.0 * h);
+            }
+            grads.push(g);
+        }
+        if grads.is_empty() {
+            break;
+        }
+        let d = min_norm_in_hull(&grads);
+        let dn = d.length();
+        if dn < 1e-12 {
+            break; // stationary: no direction raises all active tets
+        }
+        // First guess: the step at which the linear model of the worst active tet
+        // reaches the next-worst inactive one, capped at a fraction of the scale.
+        let next = qs
+            .iter()
+            .copied()
+            .filter(|&qi| qi > q + params.active_tol)
+            .fold(f64::INFINITY, f64::min);
+        let mut alpha = if next.is_finite() {
+            (next - q) / (dn * dn)
+        } else {
+            0.1 * scale / dn
+        };
+        alpha = alpha.min(0.2 * scale / dn);
+        let mut moved = false;
+        for _ in 0..params.halvings {
+            let y = x + alpha * d;
+            let qy = ball_quality_at(mesh, v, ball, y);
+            if qy > q + 1e-12 && ball_stays_positive(mesh, v, ball, y) {
+                x = y;
+                q = qy;
+                moved = true;
+                break;
+            }
+            alpha *= 0.5;
+        }
+        if !moved {
+            break;
+        }
+    }
+    if q > start {
+        mesh.set_point(v, x);
+        Some(q)
+    } else {
+        None
+    }
+}

@@ -1,0 +1,70 @@
+//! Exact counts of the √3 step on the tripod (DESIGN §5 and the seed paper §7):
+//! n tets, n_b boundary and n_i = (4n − n_b)/2 interior faces give 4n after
+//! `split`, 4n + n_i after `flip`, + 2·n_b after `boundary-split`.
+
+use std::path::Path;
+use tetrefine::io::load_mesh;
+use tetrefine::refine::{refine_step, BoundaryRule, Phase, RefineOptions};
+use tetrefine::MeshStats;
+
+fn tripod() -> tetrefine::TetMesh {
+    load_mesh(Path::new("meshes/tripod.mesh")).unwrap().0
+}
+
+fn run(stop: Phase) -> (tetrefine::TetMesh, tetrefine::refine::StepReport) {
+    let mut m = tripod();
+    let opts = RefineOptions {
+        stop_after: Some(stop),
+        boundary: BoundaryRule::Linear,
+        ..Default::default()
+    };
+    let r = refine_step(&mut m, 1, &opts);
+    m.check().unwrap();
+    (m, r)
+}
+
+#[test]
+fn tripod_counts_after_each_topological_phase() {
+    let (m, r) = run(Phase::Split);
+    assert_eq!(m.n_tets(), 11_196);
+    assert_eq!(r.split, 2_799);
+    let (m, r) = run(Phase::Flip);
+    assert_eq!(r.refused_flips, 0, "{r:?}");
+    assert_eq!(m.n_tets(), 15_939);
+    let (m, r) = run(Phase::BoundarySplit);
+    assert_eq!(m.n_tets(), 19_359);
+    assert_eq!(r.boundary_split, 1_710);
+    let (m, r) = run(Phase::BoundaryFlip);
+    eprintln!("{r:?}");
+    let s = MeshStats::compute(&m);
+    // 967 + 2,799 barycentres + 1,710 face points.
+    assert_eq!(s.nodes, 5_476);
+    // √3 on the boundary: three triangles per old face.
+    assert_eq!(s.boundary_faces, 5_130);
+    assert_eq!(r.refused_boundary_flips, 0);
+}
+
+#[test]
+fn tripod_full_step_quality() {
+    for rule in [
+        BoundaryRule::Linear,
+        BoundaryRule::Approximating,
+        BoundaryRule::Interpolating,
+    ] {
+        let mut m = tripod();
+        let opts = RefineOptions {
+            boundary: rule,
+            ..Default::default()
+        };
+        let r = refine_step(&mut m, 1, &opts);
+        m.check().unwrap();
+        let s = MeshStats::compute(&m);
+        eprintln!(
+            "{rule:?} {r:?}\n{} tets worst {:.2} avg {:.2}",
+            s.tets, s.min_dihedral_deg.worst, s.min_dihedral_deg.avg
+        );
+        assert_eq!(s.nodes, 5_476);
+        assert_eq!(s.boundary_faces, 5_130);
+        assert_eq!(s.inverted, 0);
+    }
+}
