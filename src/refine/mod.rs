@@ -17,7 +17,23 @@ pub mod parents;
 pub mod step;
 
 pub use parents::locate_parents;
-pub use step::{refine, refine_step};
+pub use step::{refine, refine_step, refine_step_with_progress};
+
+/// Progress callbacks for long phases (the CLI draws bars with them).
+/// Every method has a no-op default.
+pub trait Progress: Sync {
+    /// A phase begins with `total` work items.
+    fn phase_start(&self, _phase: Phase, _total: u64) {}
+    /// `n` more items are done.
+    fn advance(&self, _n: u64) {}
+    /// The phase is over.
+    fn phase_end(&self) {}
+}
+
+/// Reports nothing.
+pub struct NoProgress;
+
+impl Progress for NoProgress {}
 
 use crate::smooth::ImproveReport;
 use crate::surface::sqrt3::Sqrt3Rule;

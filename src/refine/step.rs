@@ -1,6 +1,6 @@
 //! The phases of one √3 step (see the module docs of [`crate::refine`]).
 
-use super::{Phase, PhaseReport, RefineOptions, StepReport};
+use super::{NoProgress, Phase, PhaseReport, Progress, RefineOptions, StepReport};
 use crate::geom::{TET_EDGES, TET_FACES};
 use crate::mesh::{edge_key, TetMesh, NO_ADJ};
 use crate::ops::{
@@ -29,6 +29,16 @@ struct StepState {
 
 /// One √3 step. `step` is 1-based (odd and even steps differ on creases).
 pub fn refine_step(mesh: &mut TetMesh, step: usize, opts: &RefineOptions) -> StepReport {
+    refine_step_with_progress(mesh, step, opts, &NoProgress)
+}
+
+/// [`refine_step`] with progress callbacks.
+pub fn refine_step_with_progress(
+    mesh: &mut TetMesh,
+    step: usize,
+    opts: &RefineOptions,
+    progress: &dyn Progress,
+) -> StepReport {
     let _ = step;
     let start = Instant::now();
     let mut report = StepReport::default();
@@ -39,6 +49,7 @@ pub fn refine_step(mesh: &mut TetMesh, step: usize, opts: &RefineOptions) -> Ste
     };
     for phase in Phase::ALL {
         let t0 = Instant::now();
+        progress.phase_start(phase, mesh.n_tets() as u64);
         match phase {
             Phase::Split => split_phase(mesh, opts, &mut report),
             Phase::Flip => flip_phase(mesh, &st, &mut report),
@@ -58,6 +69,7 @@ pub fn refine_step(mesh: &mut TetMesh, step: usize, opts: &RefineOptions) -> Ste
                 }
             }
         }
+        progress.phase_end();
         report.phases.push(PhaseReport {
             name: phase.name(),
             tets: mesh.n_tets(),

@@ -1,5 +1,6 @@
 //! Reports: statistics, histograms and JSON.
 
 pub mod stats;
+pub mod steps;
 
 pub use stats::{Histogram, MeshStats};

@@ -1,0 +1,83 @@
+//! Per-step reporting of `refine`: one table row per step, and the entries of
+//! the `--stats` JSON (`{"steps":[…]}`, the first entry being the input).
+
+use super::MeshStats;
+use crate::refine::{PhaseReport, StepReport};
+use serde::Serialize;
+
+/// One entry of `--stats`: the quality JSON of the mesh after the step, plus
+/// the step's phases and wall time (empty / 0 for the input entry).
+#[derive(Clone, Debug, Serialize)]
+pub struct StepStats {
+    /// The statistics (flattened: the same keys as `quality --json`).
+    #[serde(flatten)]
+    pub stats: MeshStats,
+    /// Phases with tets after each and their wall time.
+    pub phases: Vec<PhaseReport>,
+    /// Wall time of the step.
+    pub seconds: f64,
+    /// What the step did, operation by operation (absent for the input).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub report: Option<StepReport>,
+}
+
+impl StepStats {
+    /// The input entry.
+    pub fn input(stats: MeshStats) -> StepStats {
+        StepStats {
+            stats,
+            phases: Vec::new(),
+            seconds: 0.0,
+            report: None,
+        }
+    }
+
+    /// The entry of a refinement step.
+    pub fn step(stats: MeshStats, report: &StepReport) -> StepStats {
+        StepStats {
+            stats,
+            phases: report.phases.clone(),
+            seconds: report.seconds,
+            report: Some(report.clone()),
+        }
+    }
+}
+
+/// Header of the per-step table (the rows of Table 1 of the seed paper as
+/// columns, plus boundary faces, inverted tets and wall time).
+pub fn step_table_header() -> String {
+    format!(
+        "{:<8} {:>10} {:>11} {:>11} {:>9} {:>9} {:>9} {:>8} {:>7} {:>9} {:>8} {:>9}",
+        "",
+        "nodes",
+        "edges",
+        "tets",
+        "worst°",
+        "avg°",
+        "best°",
+        "val.avg",
+        "val.max",
+        "bnd.faces",
+        "inverted",
+        "seconds"
+    )
+}
+
+/// One row of the per-step table.
+pub fn step_row(label: &str, s: &MeshStats, seconds: f64) -> String {
+    format!(
+        "{:<8} {:>10} {:>11} {:>11} {:>9.2} {:>9.2} {:>9.2} {:>8.2} {:>7} {:>9} {:>8} {:>9.3}",
+        label,
+        s.nodes,
+        s.edges,
+        s.tets,
+        s.min_dihedral_deg.worst,
+        s.min_dihedral_deg.avg,
+        s.min_dihedral_deg.best,
+        s.valence.avg,
+        s.valence.max,
+        s.boundary_faces,
+        s.inverted,
+        seconds
+    )
+}
