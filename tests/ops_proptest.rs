@@ -20,8 +20,16 @@ fn build(points: &[DVec3], tets: &[[u32; 4]]) -> Option<TetMesh> {
     TetMesh::from_data(&data).ok().map(|(m, _)| m)
 }
 
+/// Total volume, each tet measured from the mesh's first point so that the
+/// coordinates' magnitude does not swamp the comparison.
 fn volume(m: &TetMesh) -> f64 {
-    m.tet_ids().map(|t| tet_volume(&m.tet_points(t))).sum()
+    let o = m.point(0);
+    m.tet_ids().map(|t| tet_volume(&m.tet_points(t).map(|p| p - o))).sum()
+}
+
+/// A tet whose shape does not make float volume comparisons meaningless.
+fn shapely(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> bool {
+    tetrefine::geom::tet_min_sine(&[a, b, c, d]).abs() > 0.05
 }
 
 fn boundary_faces(m: &TetMesh) -> BTreeSet<[u32; 3]> {
@@ -79,7 +87,13 @@ fn sorted_angles(raw: Vec<f64>, span: f64) -> Vec<f64> {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 200, ..ProptestConfig::default() })]
+    // A fixed seed keeps CI reproducible; change it locally to explore.
+    #![proptest_config(ProptestConfig {
+        cases: 256,
+        rng_seed: proptest::test_runner::RngSeed::Fixed(0x7e7_2e61e),
+        failure_persistence: None,
+        ..ProptestConfig::default()
+    })]
 
     #[test]
     fn split14_inside_conserves_and_outside_is_refused(
@@ -88,7 +102,7 @@ proptest! {
         out in (1.0f64..3.0),
     ) {
         let p = [a, b, c, d];
-        prop_assume!(orient3d(a, b, c, d).abs() > 1e-3);
+        prop_assume!(shapely(a, b, c, d));
         let mut m = build(&p, &[[0, 1, 2, 3]]).unwrap();
         let v0 = volume(&m);
         let faces0 = boundary_faces(&m);
@@ -294,7 +308,7 @@ proptest! {
     fn boundary_split13_conserves_volume(
         a in pt(), b in pt(), c in pt(), d in pt(), w in (0.05f64..1.0, 0.05f64..1.0, 0.05f64..1.0),
     ) {
-        prop_assume!(orient3d(a, b, c, d).abs() > 1e-2);
+        prop_assume!(shapely(a, b, c, d));
         let mut m = build(&[a, b, c, d], &[[0, 1, 2, 3]]).unwrap();
         let v0 = volume(&m);
         let t = m.tet_ids().next().unwrap();

@@ -54,20 +54,45 @@ pub fn all_positive(mesh: &TetMesh, tets: &[[u32; 4]]) -> bool {
 /// New boundary faces inherit the marker of the removed boundary faces when
 /// those all had the same one. A cavity whose interior holds a marked face is
 /// refused, as is one whose tets lie in different regions. New tets take the
-/// region, the highest `level` and the `parent` of the first old tet.
+/// region, the highest `level` and that tet's `parent`.
 ///
 /// Everything is checked before the mesh is touched: on error it is unchanged.
-pub fn replace_cavity(
-    mesh: &mut TetMesh,
-    old: &[u32],
-    new: &[[u32; 4]],
-) -> Result<Vec<u32>, OpError> {
-    if !all_positive(mesh, new) {
-        return Err(OpError::WouldInvert);
-    }
+pub fn replace_cavity(mesh: &mut TetMesh, old: &[u32], new: &[[u32; 4]]) -> Result<Vec<u32>, OpError> {
     let region = mesh.region(old[0]);
     if old.iter().any(|&t| mesh.region(t) != region) {
         return Err(OpError::NotApplicable("cavity spans two regions"));
+    }
+    if !mesh.face_markers().is_empty() {
+        for &t in old {
+            for (f, &h) in mesh.adj(t).iter().enumerate() {
+                if h != NO_ADJ
+                    && (h >> 2) > t
+                    && old.contains(&(h >> 2))
+                    && mesh.face_marker(mesh.face_vertices(t, f)).is_some()
+                {
+                    return Err(OpError::NotApplicable("would remove a marked face"));
+                }
+            }
+        }
+    }
+    let oldest = (0..old.len()).max_by_key(|&i| (mesh.level(old[i]), std::cmp::Reverse(i))).unwrap_or(0);
+    let origin = vec![oldest; new.len()];
+    replace_cavity_raw(mesh, old, new, &origin)
+}
+
+/// The core of [`replace_cavity`] for operations that manage regions and
+/// interior markers themselves (trisection, interface splits and flips):
+/// new tet `i` takes region, level and parent of `old[origin[i]]`; marked
+/// faces inside the cavity are not checked (the caller moves their markers).
+pub fn replace_cavity_raw(
+    mesh: &mut TetMesh,
+    old: &[u32],
+    new: &[[u32; 4]],
+    origin: &[usize],
+) -> Result<Vec<u32>, OpError> {
+    debug_assert_eq!(origin.len(), new.len());
+    if !all_positive(mesh, new) {
+        return Err(OpError::WouldInvert);
     }
     let check_markers = !mesh.face_markers().is_empty();
     // Outer faces of the cavity: (key, outside half-face or NO_ADJ).
@@ -76,12 +101,6 @@ pub fn replace_cavity(
         let adj = mesh.adj(t);
         for (f, &h) in adj.iter().enumerate() {
             if h != NO_ADJ && old.contains(&(h >> 2)) {
-                if check_markers
-                    && (h >> 2) > t
-                    && mesh.face_marker(mesh.face_vertices(t, f)).is_some()
-                {
-                    return Err(OpError::NotApplicable("would remove a marked face"));
-                }
                 continue;
             }
             outer.push((face_key(mesh.face_vertices(t, f)), h));
@@ -115,14 +134,12 @@ pub fn replace_cavity(
             _ => {}
         }
     }
-    let new_marker = if uniform {
-        removed_marker.flatten()
-    } else {
-        None
-    };
+    let new_marker = if uniform { removed_marker.flatten() } else { None };
 
-    let level = old.iter().map(|&t| mesh.level(t)).max().unwrap_or(0);
-    let parent = mesh.parent(old[0]);
+    let info: Vec<(i32, u8, u32)> = origin
+        .iter()
+        .map(|&i| (mesh.region(old[i]), mesh.level(old[i]), mesh.parent(old[i])))
+        .collect();
     if check_markers {
         for (k, h) in &outer {
             if *h == NO_ADJ && !open.contains(k) {
@@ -135,7 +152,8 @@ pub fn replace_cavity(
     }
     let ids: Vec<u32> = new
         .iter()
-        .map(|&v| {
+        .zip(&info)
+        .map(|(&v, &(region, level, parent))| {
             let t = mesh.alloc_tet(v, region);
             mesh.set_level(t, level);
             mesh.set_parent(t, parent);
