@@ -24,7 +24,9 @@ fn build(points: &[DVec3], tets: &[[u32; 4]]) -> Option<TetMesh> {
 /// coordinates' magnitude does not swamp the comparison.
 fn volume(m: &TetMesh) -> f64 {
     let o = m.point(0);
-    m.tet_ids().map(|t| tet_volume(&m.tet_points(t).map(|p| p - o))).sum()
+    m.tet_ids()
+        .map(|t| tet_volume(&m.tet_points(t).map(|p| p - o)))
+        .sum()
 }
 
 /// A tet whose shape does not make float volume comparisons meaningless.

@@ -10,8 +10,10 @@
 pub mod edge_removal;
 pub mod flip23;
 pub mod flip32;
+pub mod interface;
 pub mod split13;
 pub mod split14;
+pub mod trisect;
 
 use crate::geom::{orient3d, TET_FACES};
 use crate::mesh::{face_key, FaceKey, TetMesh, NO_ADJ};
@@ -19,8 +21,10 @@ use crate::mesh::{face_key, FaceKey, TetMesh, NO_ADJ};
 pub use edge_removal::{remove_edge, EdgeRing};
 pub use flip23::{flip23, flip23_tets, flip23_valid};
 pub use flip32::flip32;
+pub use interface::{remove_interface_edge, split_interface_face};
 pub use split13::split_boundary_face;
 pub use split14::split14;
+pub use trisect::trisect_edge;
 
 /// Why an operation was not applied. The mesh is unchanged in every case.
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
@@ -57,7 +61,11 @@ pub fn all_positive(mesh: &TetMesh, tets: &[[u32; 4]]) -> bool {
 /// region, the highest `level` and that tet's `parent`.
 ///
 /// Everything is checked before the mesh is touched: on error it is unchanged.
-pub fn replace_cavity(mesh: &mut TetMesh, old: &[u32], new: &[[u32; 4]]) -> Result<Vec<u32>, OpError> {
+pub fn replace_cavity(
+    mesh: &mut TetMesh,
+    old: &[u32],
+    new: &[[u32; 4]],
+) -> Result<Vec<u32>, OpError> {
     let region = mesh.region(old[0]);
     if old.iter().any(|&t| mesh.region(t) != region) {
         return Err(OpError::NotApplicable("cavity spans two regions"));
@@ -75,7 +83,9 @@ pub fn replace_cavity(mesh: &mut TetMesh, old: &[u32], new: &[[u32; 4]]) -> Resu
             }
         }
     }
-    let oldest = (0..old.len()).max_by_key(|&i| (mesh.level(old[i]), std::cmp::Reverse(i))).unwrap_or(0);
+    let oldest = (0..old.len())
+        .max_by_key(|&i| (mesh.level(old[i]), std::cmp::Reverse(i)))
+        .unwrap_or(0);
     let origin = vec![oldest; new.len()];
     replace_cavity_raw(mesh, old, new, &origin)
 }
@@ -134,7 +144,11 @@ pub fn replace_cavity_raw(
             _ => {}
         }
     }
-    let new_marker = if uniform { removed_marker.flatten() } else { None };
+    let new_marker = if uniform {
+        removed_marker.flatten()
+    } else {
+        None
+    };
 
     let info: Vec<(i32, u8, u32)> = origin
         .iter()

@@ -13,6 +13,7 @@
 //! 6. `optimize` — interior edge removal and vertex smoothing
 //!    ([`crate::smooth::improve`]).
 
+pub mod features;
 pub mod parents;
 pub mod step;
 
@@ -197,8 +198,15 @@ pub struct StepReport {
     pub boundary_split: usize,
     /// Old boundary edges flipped.
     pub boundary_flipped: usize,
-    /// Boundary edge flips refused (would invert, marker change, feature).
+    /// Boundary edge flips refused (would invert, marker change, untagged
+    /// junction, or not all faces around the edge split).
     pub refused_boundary_flips: usize,
+    /// Interface faces split 2-6.
+    pub interface_split: usize,
+    /// Feature edges kept (odd step).
+    pub kept_feature_edges: usize,
+    /// Feature edges trisected (even step).
+    pub trisected_feature_edges: usize,
     /// Boundary points moved the full way.
     pub full_moves: usize,
     /// Boundary point moves shortened to avoid an inverted tet.

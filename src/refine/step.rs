@@ -1,10 +1,11 @@
 //! The phases of one √3 step (see the module docs of [`crate::refine`]).
 
 use super::{NoProgress, Phase, PhaseReport, Progress, RefineOptions, StepReport};
-use crate::geom::{TET_EDGES, TET_FACES};
+use crate::geom::TET_EDGES;
 use crate::mesh::{edge_key, TetMesh, NO_ADJ};
 use crate::ops::{
-    flip23, flip23_valid, remove_edge, split14, split_boundary_face, EdgeRing, OpError,
+    flip23, flip23_valid, remove_edge, remove_interface_edge, split14, split_boundary_face,
+    split_interface_face, trisect_edge, EdgeRing, OpError,
 };
 use crate::smooth::{ball_stays_positive, improve, ImproveOptions};
 use crate::surface::sqrt3::sqrt3_positions;
@@ -25,6 +26,12 @@ struct StepState {
     first_face_point: u32,
     /// Old boundary faces that were split, outward-oriented, with their new point.
     split_faces: Vec<([u32; 3], u32)>,
+    /// Old interface faces (between regions, or marked) that were split, with
+    /// their new point.
+    split_interfaces: Vec<([u32; 3], u32)>,
+    /// 1-based step number: feature edges are kept in odd steps and trisected
+    /// in even ones.
+    step: usize,
 }
 
 /// One √3 step. `step` is 1-based (odd and even steps differ on creases).
@@ -39,13 +46,14 @@ pub fn refine_step_with_progress(
     opts: &RefineOptions,
     progress: &dyn Progress,
 ) -> StepReport {
-    let _ = step;
     let start = Instant::now();
     let mut report = StepReport::default();
     let mut st = StepState {
         first_barycentre: mesh.n_points() as u32,
         first_face_point: u32::MAX,
         split_faces: Vec::new(),
+        split_interfaces: Vec::new(),
+        step,
     };
     for phase in Phase::ALL {
         let t0 = Instant::now();
@@ -128,7 +136,7 @@ fn flip_phase(mesh: &mut TetMesh, st: &StepState, report: &mut StepReport) {
             continue;
         }
         let (u, g) = TetMesh::half_face(h);
-        if u > t && mesh.tet(u)[g] >= first {
+        if u > t && mesh.tet(u)[g] >= first && !is_constrained(mesh, t, i) {
             faces.push((t, i));
         }
     }
@@ -223,19 +231,38 @@ fn make_flips_valid(
     }
 }
 
-/// Phase 3: 1-3 split of every boundary face of a split tet, at its barycentre.
+/// Whether interior face `f` of `t` must survive like the boundary: it
+/// separates two regions or carries a marker.
+fn is_constrained(mesh: &TetMesh, t: u32, f: usize) -> bool {
+    let h = mesh.adj(t)[f];
+    h != NO_ADJ
+        && (mesh.region(h >> 2) != mesh.region(t)
+            || (!mesh.face_markers().is_empty()
+                && mesh.face_marker(mesh.face_vertices(t, f)).is_some()))
+}
+
+/// Phase 3: 1-3 split of every boundary face of a split tet at its
+/// barycentre, and the 2-6 split of every interface face whose two tets were
+/// split.
 fn boundary_split_phase(mesh: &mut TetMesh, st: &mut StepState, report: &mut StepReport) {
     let first = st.first_barycentre;
     st.first_face_point = mesh.n_points() as u32;
     let mut faces = Vec::new();
+    let mut interfaces = Vec::new();
     for t in mesh.tet_ids() {
         let v = mesh.tet(t);
         for f in 0..4 {
-            if v[f] >= first
-                && mesh.is_boundary_face(t, f)
-                && (0..4).all(|j| j == f || v[j] < first)
-            {
+            if v[f] < first || !(0..4).all(|j| j == f || v[j] < first) {
+                continue;
+            }
+            if mesh.is_boundary_face(t, f) {
                 faces.push((t, f));
+            } else if is_constrained(mesh, t, f) {
+                let (u, g) = TetMesh::half_face(mesh.adj(t)[f]);
+                let w = mesh.tet(u);
+                if u > t && w[g] >= first && (0..4).all(|j| j == g || w[j] < first) {
+                    interfaces.push((t, f));
+                }
             }
         }
     }
@@ -248,64 +275,147 @@ fn boundary_split_phase(mesh: &mut TetMesh, st: &mut StepState, report: &mut Ste
             report.boundary_split += 1;
         }
     }
+    for (t, f) in interfaces {
+        let fv = mesh.face_vertices(t, f);
+        let p = fv.map(|x| mesh.point(x));
+        let c = (p[0] + p[1] + p[2]) / 3.0;
+        if let Ok(m) = split_interface_face(mesh, t, f, c) {
+            st.split_interfaces.push((fv, m));
+            report.interface_split += 1;
+        }
+    }
 }
 
-/// Phase 4: every old boundary edge whose two boundary faces were split is
-/// removed; the new boundary edge joins the two face points.
+/// A tet holding the edge `(a, b)` and its local edge index, searched in the
+/// ball of `near` (a vertex known to share a tet with the edge).
+fn tet_with_edge(
+    mesh: &TetMesh,
+    near: u32,
+    a: u32,
+    b: u32,
+    ball: &mut Vec<u32>,
+) -> Option<(u32, usize)> {
+    mesh.ball(near, ball);
+    ball.iter().find_map(|&t| {
+        let v = mesh.tet(t);
+        let ia = v.iter().position(|&x| x == a)?;
+        let ib = v.iter().position(|&x| x == b)?;
+        let e = TET_EDGES
+            .iter()
+            .position(|&[i, j]| (i == ia && j == ib) || (i == ib && j == ia))?;
+        Some((t, e))
+    })
+}
+
+/// Ring vertices `p` of `ring` whose face `(a, b, p)` is constrained (boundary
+/// ends of an open ring, region changes, marked faces).
+fn constrained_ring_vertices(mesh: &TetMesh, ring: &EdgeRing) -> Vec<u32> {
+    let r = ring.verts.len();
+    let mut out = Vec::new();
+    if !ring.closed {
+        out.push(ring.verts[0]);
+        out.push(ring.verts[r - 1]);
+    }
+    let n = ring.tets.len();
+    let inner = if ring.closed { 0..n } else { 1..n };
+    for i in inner {
+        // Face (a, b, verts[i]) lies between tets i-1 and i.
+        let (t0, t1) = (ring.tets[(i + n - 1) % n], ring.tets[i]);
+        let p = ring.verts[i];
+        let marked =
+            !mesh.face_markers().is_empty() && mesh.face_marker([ring.a, ring.b, p]).is_some();
+        if mesh.region(t0) != mesh.region(t1) || marked {
+            out.push(p);
+        }
+    }
+    out
+}
+
+/// Phase 4: every old boundary or interface edge whose constrained faces were
+/// all split is flipped (boundary: edge removal, m → 2m − 2; interface: the
+/// two-sided removal of [`remove_interface_edge`]), so that the new edge joins
+/// two face points. Feature edges are kept in odd steps and trisected in even
+/// steps (seed paper §5).
 fn boundary_flip_phase(mesh: &mut TetMesh, st: &StepState, report: &mut StepReport) {
     let fp = st.first_face_point;
-    // Old edges seen from the split faces; flip those seen twice (both sides).
+    // Old edges seen from the split faces, with how often and one face point.
     let mut seen: HashMap<[u32; 2], (u32, u8)> =
         HashMap::with_capacity(3 * st.split_faces.len() / 2);
-    for &(f, m) in &st.split_faces {
+    for &(f, m) in st.split_faces.iter().chain(&st.split_interfaces) {
         for i in 0..3 {
             let k = edge_key(f[i], f[(i + 1) % 3]);
             seen.entry(k).and_modify(|e| e.1 += 1).or_insert((m, 1));
         }
     }
-    let mut edges: Vec<([u32; 2], u32)> = seen
-        .into_iter()
-        .filter(|(_, (_, n))| *n == 2)
-        .map(|(k, (m, _))| (k, m))
-        .collect();
+    let mut edges: Vec<([u32; 2], u32)> = seen.iter().map(|(k, (m, _))| (*k, *m)).collect();
     edges.sort_unstable();
+    let even = st.step % 2 == 0;
     let mut ball = Vec::new();
     let mut ring = EdgeRing::default();
     for ([a, b], m) in edges {
-        if mesh.is_feature_edge(a, b) {
-            report.refused_boundary_flips += 1;
+        let is_feature = mesh.is_feature_edge(a, b);
+        if is_feature && !even {
+            report.kept_feature_edges += 1;
             continue;
         }
-        // A tet holding a, b and the face point m.
-        mesh.ball(m, &mut ball);
-        let found = ball.iter().find_map(|&t| {
-            let v = mesh.tet(t);
-            let ia = v.iter().position(|&x| x == a)?;
-            let ib = v.iter().position(|&x| x == b)?;
-            let e = TET_EDGES
-                .iter()
-                .position(|&[i, j]| (i == ia && j == ib) || (i == ib && j == ia))?;
-            Some((t, e))
-        });
-        let Some((t, e)) = found else {
+        let Some((t, e)) = tet_with_edge(mesh, m, a, b, &mut ball) else {
             report.refused_boundary_flips += 1;
             continue;
         };
         ring.gather_into(mesh, t, e);
-        let ends_ok = !ring.closed
-            && ring.verts.first().is_some_and(|&x| x >= fp)
-            && ring.verts.last().is_some_and(|&x| x >= fp);
-        let (p0, pm) = (ring.verts[0], *ring.verts.last().unwrap_or(&0));
-        let same_marker = mesh.face_marker([a, b, p0]) == mesh.face_marker([a, b, pm]);
-        if !ends_ok || !same_marker {
+        let cons = constrained_ring_vertices(mesh, &ring);
+        // Every constrained face around the edge must have been split.
+        if cons.iter().any(|&p| p < fp) {
             report.refused_boundary_flips += 1;
             continue;
         }
-        match remove_edge(mesh, &ring, f64::NEG_INFINITY) {
-            Ok(_) => report.boundary_flipped += 1,
-            Err(OpError::WouldInvert) | Err(_) => report.refused_boundary_flips += 1,
+        if is_feature {
+            // x1 must sit next to ring.a, which need not be the smaller id.
+            let (pa, pb) = (mesh.point(ring.a), mesh.point(ring.b));
+            match trisect_edge(
+                mesh,
+                &ring,
+                pa + (pb - pa) / 3.0,
+                pa + (pb - pa) * (2.0 / 3.0),
+            ) {
+                Ok(_) => report.trisected_feature_edges += 1,
+                Err(e) => {
+                    if std::env::var("TR_DBG").is_ok() {
+                        eprintln!("trisect {a} {b}: {e}");
+                    }
+                    report.refused_boundary_flips += 1
+                }
+            }
+            continue;
+        }
+        if cons.len() != 2 {
+            // Three or more constrained faces meet here but the edge is not
+            // tagged (features off): flipping would break a junction.
+            report.refused_boundary_flips += 1;
+            continue;
+        }
+        let result = if ring.closed {
+            remove_interface_edge(mesh, &ring, cons[0], cons[1])
+        } else {
+            let same_marker =
+                mesh.face_marker([a, b, cons[0]]) == mesh.face_marker([a, b, cons[1]]);
+            if !same_marker {
+                report.refused_boundary_flips += 1;
+                continue;
+            }
+            remove_edge(mesh, &ring, f64::NEG_INFINITY).map(|_| ())
+        };
+        match result {
+            Ok(()) => report.boundary_flipped += 1,
+            Err(e) => {
+                if std::env::var("TR_DBG").is_ok() {
+                    eprintln!("flip {a} {b}: {e} closed {}", ring.closed);
+                }
+                report.refused_boundary_flips += 1
+            }
         }
     }
+    let _ = OpError::WouldInvert;
 }
 
 /// Phase 5: the √3 stencils on the old boundary points and the new face
@@ -335,6 +445,18 @@ fn boundary_smooth_phase(
         &creases,
         &corners,
     );
+    // Points that never move here: on a feature edge, corners, required
+    // vertices, and every point of an interface (interfaces are refined
+    // linearly so that each region stays exactly what it was).
+    let mut pinned: HashSet<u32> = corners.clone();
+    for e in &creases {
+        pinned.insert(e[0]);
+        pinned.insert(e[1]);
+    }
+    for (f, m) in &st.split_interfaces {
+        pinned.extend(f.iter().copied());
+        pinned.insert(*m);
+    }
     // Targets: old boundary vertices, then face points.
     let mut targets: Vec<(u32, DVec3)> = Vec::new();
     let mut old: Vec<u32> = tris.iter().flatten().copied().collect();
@@ -349,7 +471,7 @@ fn boundary_smooth_phase(
     let mut ball = Vec::new();
     for (v, target) in targets {
         let from = mesh.point(v);
-        if target == from {
+        if target == from || pinned.contains(&v) {
             continue;
         }
         mesh.ball(v, &mut ball);
@@ -373,5 +495,4 @@ fn boundary_smooth_phase(
             report.skipped_moves += 1;
         }
     }
-    let _ = TET_FACES;
 }
