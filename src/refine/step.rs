@@ -5,7 +5,7 @@ use crate::geom::TET_EDGES;
 use crate::mesh::{edge_key, TetMesh, NO_ADJ};
 use crate::ops::{
     flip23, flip23_valid, remove_edge, remove_interface_edge, split14, split_boundary_face,
-    split_interface_face, trisect_edge, EdgeRing, OpError,
+    split_interface_face, trisect_edge, EdgeRing,
 };
 use crate::smooth::{ball_stays_positive, improve, ImproveOptions};
 use crate::surface::sqrt3::sqrt3_positions;
@@ -379,12 +379,7 @@ fn boundary_flip_phase(mesh: &mut TetMesh, st: &StepState, report: &mut StepRepo
                 pa + (pb - pa) * (2.0 / 3.0),
             ) {
                 Ok(_) => report.trisected_feature_edges += 1,
-                Err(e) => {
-                    if std::env::var("TR_DBG").is_ok() {
-                        eprintln!("trisect {a} {b}: {e}");
-                    }
-                    report.refused_boundary_flips += 1
-                }
+                Err(_) => report.refused_boundary_flips += 1,
             }
             continue;
         }
@@ -407,15 +402,9 @@ fn boundary_flip_phase(mesh: &mut TetMesh, st: &StepState, report: &mut StepRepo
         };
         match result {
             Ok(()) => report.boundary_flipped += 1,
-            Err(e) => {
-                if std::env::var("TR_DBG").is_ok() {
-                    eprintln!("flip {a} {b}: {e} closed {}", ring.closed);
-                }
-                report.refused_boundary_flips += 1
-            }
+            Err(_) => report.refused_boundary_flips += 1,
         }
     }
-    let _ = OpError::WouldInvert;
 }
 
 /// Phase 5: the √3 stencils on the old boundary points and the new face
