@@ -11,3 +11,4 @@ pub mod vtp;
 
 pub use io::{load_surface, read_surface, write_surface, SurfaceFile, SurfaceFormat};
 pub use polymesh::{Component, HalfEdges, PolyMesh, TopologyError, NO_TWIN};
+pub mod sqrt3;
