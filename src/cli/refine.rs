@@ -57,6 +57,7 @@ pub fn run(a: Args) -> super::CliResult {
         threshold: a.threshold,
         stop_after: a.stop_after,
         selection: None,
+        check_each_phase: false,
     };
     let t0 = Instant::now();
     let first = MeshStats::compute(&mesh);

@@ -63,6 +63,40 @@ pub fn edge_key(a: u32, b: u32) -> EdgeKey {
     }
 }
 
+/// Per-slot marks for walks over tets (balls, cavities) without hashing: a
+/// slot is marked when its stamp equals the current epoch, so clearing is O(1).
+#[derive(Clone, Debug, Default)]
+pub struct TetMarks {
+    stamp: Vec<u32>,
+    epoch: u32,
+}
+
+impl TetMarks {
+    /// Starts a new walk over a mesh with `slots` tet slots: nothing is marked.
+    pub fn begin(&mut self, slots: usize) {
+        if self.stamp.len() < slots {
+            self.stamp.resize(slots, 0);
+        }
+        self.epoch = self.epoch.wrapping_add(1);
+        if self.epoch == 0 {
+            self.stamp.iter_mut().for_each(|s| *s = 0);
+            self.epoch = 1;
+        }
+    }
+
+    /// Marks `t`; returns whether it was unmarked before.
+    #[inline]
+    pub fn mark(&mut self, t: u32) -> bool {
+        let s = &mut self.stamp[t as usize];
+        if *s == self.epoch {
+            false
+        } else {
+            *s = self.epoch;
+            true
+        }
+    }
+}
+
 /// An indexed tetrahedral mesh with face adjacency and tag side tables.
 #[derive(Clone, Debug, Default)]
 pub struct TetMesh {
@@ -487,6 +521,29 @@ impl TetMesh {
             if v[0] != DEAD {
                 for &x in v {
                     self.v2t[x as usize] = t as u32;
+                }
+            }
+        }
+    }
+
+    /// [`TetMesh::ball`] with caller-owned marks: O(ball size).
+    pub fn ball_marked(&self, v: u32, out: &mut Vec<u32>, marks: &mut TetMarks) {
+        out.clear();
+        let Some(start) = self.tet_of_vertex(v) else {
+            return;
+        };
+        marks.begin(self.tets.len());
+        marks.mark(start);
+        out.push(start);
+        let mut i = 0;
+        while i < out.len() {
+            let t = out[i];
+            i += 1;
+            let tv = self.tets[t as usize];
+            let adj = self.adj[t as usize];
+            for f in 0..4 {
+                if tv[f] != v && adj[f] != NO_ADJ && marks.mark(adj[f] >> 2) {
+                    out.push(adj[f] >> 2);
                 }
             }
         }

@@ -155,6 +155,9 @@ pub struct RefineOptions {
     pub stop_after: Option<Phase>,
     /// Per tet slot: is it selected for splitting? `None` = every tet.
     pub selection: Option<Vec<bool>>,
+    /// Run [`TetMesh::check`](crate::TetMesh::check) after every phase and
+    /// record failures in [`StepReport::check_failures`] (tests, debugging).
+    pub check_each_phase: bool,
 }
 
 impl Default for RefineOptions {
@@ -165,6 +168,7 @@ impl Default for RefineOptions {
             threshold: 0.3,
             stop_after: None,
             selection: None,
+            check_each_phase: false,
         }
     }
 }
@@ -217,4 +221,8 @@ pub struct StepReport {
     pub improve: ImproveReport,
     /// Wall time of the whole step.
     pub seconds: f64,
+    /// With `check_each_phase`: `phase: error` for every phase after which
+    /// the mesh failed its invariants.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub check_failures: Vec<String>,
 }

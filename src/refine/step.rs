@@ -78,6 +78,11 @@ pub fn refine_step_with_progress(
             }
         }
         progress.phase_end();
+        if opts.check_each_phase {
+            if let Err(e) = mesh.check() {
+                report.check_failures.push(format!("{phase}: {e}"));
+            }
+        }
         report.phases.push(PhaseReport {
             name: phase.name(),
             tets: mesh.n_tets(),

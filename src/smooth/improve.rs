@@ -9,12 +9,12 @@
 //! (closed rings inside one region) are removed, so the domain, its regions
 //! and its tags are untouched.
 
-use super::ball_quality;
 use super::laplacian::laplacian_smooth;
 use super::optimize::{optimize_vertex, OptimizeParams};
-use crate::geom::tet_min_sine;
-use crate::mesh::{TetMesh, NO_ADJ};
+use crate::geom::{tet_min_sine, TET_EDGES};
+use crate::mesh::{edge_key, TetMarks, TetMesh, NO_ADJ};
 use crate::ops::{remove_edge, EdgeRing};
+use std::collections::HashSet;
 
 /// Options of [`improve`].
 #[derive(Clone, Debug)]
@@ -93,6 +93,65 @@ pub fn fixed_vertices(mesh: &TetMesh) -> Vec<bool> {
     fixed
 }
 
+/// Work-tracking state of [`improve`]: per-slot quality and dirty flags, so
+/// that later passes only revisit what the previous one changed.
+struct Tracker {
+    /// Min-sine quality per tet slot.
+    tq: Vec<f64>,
+    /// Tet slots touched since they were last examined for edge removal.
+    tet_dirty: Vec<bool>,
+    /// Vertices whose ball changed since they were last examined.
+    vert_dirty: Vec<bool>,
+    /// Tet slots whose edges may be removed.
+    allowed: Option<Vec<bool>>,
+}
+
+impl Tracker {
+    fn new(mesh: &TetMesh, allowed: Option<Vec<bool>>) -> Tracker {
+        let tq = (0..mesh.n_tet_slots() as u32)
+            .map(|t| {
+                if mesh.is_alive(t) {
+                    tet_min_sine(&mesh.tet_points(t))
+                } else {
+                    f64::INFINITY
+                }
+            })
+            .collect();
+        Tracker {
+            tq,
+            tet_dirty: vec![true; mesh.n_tet_slots()],
+            vert_dirty: vec![true; mesh.n_points()],
+            allowed,
+        }
+    }
+
+    fn grow(&mut self, slots: usize) {
+        if self.tq.len() < slots {
+            self.tq.resize(slots, f64::INFINITY);
+            self.tet_dirty.resize(slots, false);
+            if let Some(a) = &mut self.allowed {
+                a.resize(slots, false);
+            }
+        }
+    }
+
+    /// Refreshes the quality of `t` and flags it and its vertices.
+    fn touch(&mut self, mesh: &TetMesh, t: u32) {
+        self.grow(mesh.n_tet_slots());
+        self.tq[t as usize] = tet_min_sine(&mesh.tet_points(t));
+        self.tet_dirty[t as usize] = true;
+        for v in mesh.tet(t) {
+            self.vert_dirty[v as usize] = true;
+        }
+    }
+
+    fn is_allowed(&self, t: u32) -> bool {
+        self.allowed
+            .as_ref()
+            .is_none_or(|a| a.get(t as usize).copied().unwrap_or(false))
+    }
+}
+
 /// Runs the optimisation passes on `mesh`.
 pub fn improve(mesh: &mut TetMesh, opts: &ImproveOptions) -> ImproveReport {
     let fixed = fixed_vertices(mesh);
@@ -100,77 +159,110 @@ pub fn improve(mesh: &mut TetMesh, opts: &ImproveOptions) -> ImproveReport {
     let mut ring = EdgeRing::default();
     let mut ball = Vec::new();
     let mut scratch = Vec::new();
+    let mut marks = TetMarks::default();
     let params = OptimizeParams::default();
+    let mut tr = Tracker::new(mesh, opts.tet_allowed.clone());
+    let movable = |v: u32| {
+        !fixed[v as usize]
+            && opts
+                .movable
+                .as_ref()
+                .is_none_or(|m| m.get(v as usize).copied().unwrap_or(false))
+    };
     for _ in 0..opts.passes {
         report.passes += 1;
         let mut changed = 0;
 
-        // Interior edge removal.
-        let slots = mesh.n_tet_slots() as u32;
-        for t in 0..slots {
-            if !mesh.is_alive(t) {
+        // Interior edge removal, on the edges of dirty low-quality tets, each
+        // edge tried once per pass.
+        let candidates: Vec<u32> = (0..mesh.n_tet_slots() as u32)
+            .filter(|&t| {
+                let i = t as usize;
+                mesh.is_alive(t)
+                    && tr.tet_dirty[i]
+                    && tr.tq[i] < opts.edge_threshold
+                    && tr.is_allowed(t)
+            })
+            .collect();
+        for &t in &candidates {
+            tr.tet_dirty[t as usize] = false;
+        }
+        let mut tried: HashSet<[u32; 2]> = HashSet::with_capacity(4 * candidates.len());
+        for t in candidates {
+            if !mesh.is_alive(t) || tr.tq[t as usize] >= opts.edge_threshold {
                 continue;
             }
-            if let Some(allowed) = &opts.tet_allowed {
-                if !allowed.get(t as usize).copied().unwrap_or(false) {
+            let v = mesh.tet(t);
+            for (e, [i, j]) in TET_EDGES.iter().enumerate() {
+                if !tried.insert(edge_key(v[*i], v[*j])) || mesh.is_feature_edge(v[*i], v[*j]) {
                     continue;
                 }
-            }
-            if tet_min_sine(&mesh.tet_points(t)) >= opts.edge_threshold {
-                continue;
-            }
-            for e in 0..6 {
                 ring.gather_into(mesh, t, e);
                 if !ring.closed
                     || ring.tets.len() > opts.max_ring
-                    || mesh.is_feature_edge(ring.a, ring.b)
+                    || !ring.tets.iter().all(|&u| tr.is_allowed(u))
                 {
                     continue;
                 }
-                if let Some(allowed) = &opts.tet_allowed {
-                    if ring
-                        .tets
-                        .iter()
-                        .any(|&u| !allowed.get(u as usize).copied().unwrap_or(false))
-                    {
-                        continue;
-                    }
-                }
-                let worst = ring.worst_quality(mesh);
-                if remove_edge(mesh, &ring, worst + 1e-12).is_ok() {
+                let worst = ring
+                    .tets
+                    .iter()
+                    .map(|&u| tr.tq[u as usize])
+                    .fold(f64::INFINITY, f64::min);
+                if let Ok(new) = remove_edge(mesh, &ring, worst + 1e-12) {
                     changed += 1;
                     report.edges_removed += 1;
+                    for n in new {
+                        tr.touch(mesh, n);
+                        if let Some(a) = &mut tr.allowed {
+                            a[n as usize] = true;
+                        }
+                    }
                     break; // t is gone
                 }
             }
         }
 
-        // Vertex smoothing.
+        // Vertex smoothing of dirty vertices whose worst tet is poor.
+        let mut vq = vec![f64::INFINITY; mesh.n_points()];
+        for t in mesh.tet_ids() {
+            let q = tr.tq[t as usize];
+            for x in mesh.tet(t) {
+                let s = &mut vq[x as usize];
+                *s = s.min(q);
+            }
+        }
         for v in 0..mesh.n_points() as u32 {
-            if fixed[v as usize] {
+            if !tr.vert_dirty[v as usize] || !movable(v) {
                 continue;
             }
-            if let Some(m) = &opts.movable {
-                if !m.get(v as usize).copied().unwrap_or(false) {
-                    continue;
-                }
+            tr.vert_dirty[v as usize] = false;
+            if vq[v as usize] >= opts.threshold.max(opts.laplacian_threshold) {
+                continue;
             }
-            mesh.ball(v, &mut ball);
+            mesh.ball_marked(v, &mut ball, &mut marks);
             if ball.is_empty() {
                 continue;
             }
-            let mut q = ball_quality(mesh, &ball);
-            if q >= opts.threshold.max(opts.laplacian_threshold) {
-                continue;
-            }
+            let mut q = ball
+                .iter()
+                .map(|&t| tr.tq[t as usize])
+                .fold(f64::INFINITY, f64::min);
+            let mut moved = false;
             if let Some(q2) = laplacian_smooth(mesh, v, &ball, q, &mut scratch) {
                 q = q2;
-                changed += 1;
+                moved = true;
                 report.laplacian_moves += 1;
             }
             if q < opts.threshold && optimize_vertex(mesh, v, &ball, &params).is_some() {
-                changed += 1;
+                moved = true;
                 report.optimized_moves += 1;
+            }
+            if moved {
+                changed += 1;
+                for &t in &ball {
+                    tr.touch(mesh, t);
+                }
             }
         }
         if changed == 0 {
