@@ -10,41 +10,63 @@
 //!                                        three pieces.
 //! ```
 
-use super::{replace_cavity_raw, EdgeRing, OpError};
+use super::{replace_cavity_raw, OpError};
 use crate::mesh::TetMesh;
 use glam::DVec3;
 
-/// Trisects the edge of `ring` with new vertices at `x1` (next to `ring.a`)
-/// and `x2` (next to `ring.b`). Works for open and closed rings and for rings
-/// whose tets lie in several regions (each new tet keeps its old tet's
-/// region). Returns the two new vertex ids.
+/// Trisects the edge `(a, b)` with new vertices at `x1` (next to `a`) and
+/// `x2` (next to `b`). `around` must list every tet holding the edge (any
+/// order; several fans where the domain touches itself along the edge). Each
+/// tet is cut in three by substituting the new points along the edge, which
+/// keeps its orientation; each piece keeps its tet's region. Returns the two
+/// new vertex ids.
 pub fn trisect_edge(
     mesh: &mut TetMesh,
-    ring: &EdgeRing,
+    a: u32,
+    b: u32,
+    around: &[u32],
     x1: DVec3,
     x2: DVec3,
 ) -> Result<(u32, u32), OpError> {
-    let (a, b) = (ring.a, ring.b);
-    let n = ring.tets.len();
+    if around.is_empty() {
+        return Err(OpError::NotApplicable("no tet holds the edge"));
+    }
     let v1 = mesh.add_point(x1);
     let v2 = mesh.add_point(x2);
-    let r = ring.verts.len();
-    let mut new = Vec::with_capacity(3 * n);
-    let mut origin = Vec::with_capacity(3 * n);
-    for i in 0..n {
-        let (p, q) = (ring.verts[i], ring.verts[(i + 1) % r]);
-        new.push([a, v1, p, q]);
-        new.push([v1, v2, p, q]);
-        new.push([v2, b, p, q]);
+    let mut new = Vec::with_capacity(3 * around.len());
+    let mut origin = Vec::with_capacity(3 * around.len());
+    let mut others: Vec<u32> = Vec::new();
+    for (i, &t) in around.iter().enumerate() {
+        let v = mesh.tet(t);
+        let (Some(ia), Some(ib)) = (
+            v.iter().position(|&x| x == a),
+            v.iter().position(|&x| x == b),
+        ) else {
+            mesh.pop_unused_point(v2);
+            mesh.pop_unused_point(v1);
+            return Err(OpError::NotApplicable(
+                "a listed tet does not hold the edge",
+            ));
+        };
+        let mut t1 = v;
+        t1[ib] = v1;
+        let mut t2 = v;
+        t2[ia] = v1;
+        t2[ib] = v2;
+        let mut t3 = v;
+        t3[ia] = v2;
+        new.extend([t1, t2, t3]);
         origin.extend([i, i, i]);
+        others.extend(v.iter().copied().filter(|&x| x != a && x != b));
     }
-    let face_markers: Vec<(u32, Option<i32>)> = ring
-        .verts
+    others.sort_unstable();
+    others.dedup();
+    let face_markers: Vec<(u32, Option<i32>)> = others
         .iter()
         .map(|&p| (p, mesh.face_marker([a, b, p])))
         .collect();
     let edge_marker = mesh.feature_edge(a, b);
-    match replace_cavity_raw(mesh, &ring.tets, &new, &origin) {
+    match replace_cavity_raw(mesh, around, &new, &origin) {
         Ok(_) => {
             for (p, m) in face_markers {
                 if m.is_some() {

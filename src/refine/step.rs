@@ -2,7 +2,7 @@
 
 use super::{NoProgress, Phase, PhaseReport, Progress, RefineOptions, StepReport};
 use crate::geom::TET_EDGES;
-use crate::mesh::{edge_key, TetMesh, NO_ADJ};
+use crate::mesh::{edge_key, TetMarks, TetMesh, NO_ADJ};
 use crate::ops::{
     flip23, flip23_valid, remove_edge, remove_interface_edge, split14, split_boundary_face,
     split_interface_face, trisect_edge, EdgeRing,
@@ -353,9 +353,11 @@ fn boundary_flip_phase(mesh: &mut TetMesh, st: &StepState, report: &mut StepRepo
         }
     }
     let mut edges: Vec<([u32; 2], u32)> = seen.iter().map(|(k, (m, _))| (*k, *m)).collect();
+    let seen_count: HashMap<[u32; 2], u8> = seen.iter().map(|(k, (_, n))| (*k, *n)).collect();
     edges.sort_unstable();
     let even = st.step % 2 == 0;
     let mut ball = Vec::new();
+    let mut marks = TetMarks::default();
     let mut ring = EdgeRing::default();
     for ([a, b], m) in edges {
         let is_feature = mesh.is_feature_edge(a, b);
@@ -375,22 +377,21 @@ fn boundary_flip_phase(mesh: &mut TetMesh, st: &StepState, report: &mut StepRepo
             continue;
         }
         if is_feature {
-            // x1 must sit next to ring.a, which need not be the smaller id.
-            let (pa, pb) = (mesh.point(ring.a), mesh.point(ring.b));
-            match trisect_edge(
-                mesh,
-                &ring,
-                pa + (pb - pa) / 3.0,
-                pa + (pb - pa) * (2.0 / 3.0),
-            ) {
+            // Every tet holding the edge, over all its fans.
+            mesh.ball_marked(a, &mut ball, &mut marks);
+            ball.retain(|&u| mesh.tet(u).contains(&b));
+            let (pa, pb) = (mesh.point(a), mesh.point(b));
+            let (x1, x2) = (pa + (pb - pa) / 3.0, pa + (pb - pa) * (2.0 / 3.0));
+            match trisect_edge(mesh, a, b, &ball, x1, x2) {
                 Ok(_) => report.trisected_feature_edges += 1,
                 Err(_) => report.refused_boundary_flips += 1,
             }
             continue;
         }
-        if cons.len() != 2 {
-            // Three or more constrained faces meet here but the edge is not
-            // tagged (features off): flipping would break a junction.
+        if cons.len() != 2 || seen_count[&[a, b]] != 2 {
+            // Three or more constrained faces meet here (or the domain touches
+            // itself along the edge) but the edge is not tagged: flipping
+            // would break the junction.
             report.refused_boundary_flips += 1;
             continue;
         }
