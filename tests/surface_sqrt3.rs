@@ -431,7 +431,10 @@ fn bad_input_is_refused_with_a_reason() {
     .unwrap_err();
     assert!(e.to_string().contains("orientations disagree"), "{e}");
     let opts = Sqrt3Options {
-        creases: vec![[0, 1]],
+        features: tetrefine::surface::features::Features {
+            creases: vec![[0, 1]],
+            ..Default::default()
+        },
         ..Default::default()
     };
     let e = sqrt3(&octahedron(), Sqrt3Rule::Approximating, 1, &opts).unwrap_err();
