@@ -112,7 +112,11 @@ fn vertex_weight_follows_equation_three() {
         &Features::default(),
     )
     .unwrap();
-    assert!(out.points[0].distance(DVec3::splat(5.0 / 18.0)) < 1e-15, "{}", out.points[0]);
+    assert!(
+        out.points[0].distance(DVec3::splat(5.0 / 18.0)) < 1e-15,
+        "{}",
+        out.points[0]
+    );
 }
 
 #[test]
@@ -129,8 +133,8 @@ fn edge_weight_and_extrusion_follow_equation_two() {
     let out = catmull_clark_weighted(&mesh, 1, &cfg, &Features::default()).unwrap();
     let (f1, f2) = (DVec3::new(0.5, 0.5, 0.0), DVec3::new(0.5, 0.0, 0.5));
     let (p1, p2) = (DVec3::ZERO, DVec3::X);
-    let expect = ((f1 + f2) * 1.5 + (p1 + p2) * 0.5) / 4.0
-        + DVec3::new(0.0, -1.0, -1.0) / 2f64.sqrt() * 0.3;
+    let expect =
+        ((f1 + f2) * 1.5 + (p1 + p2) * 0.5) / 4.0 + DVec3::new(0.0, -1.0, -1.0) / 2f64.sqrt() * 0.3;
     let e01 = mesh.edge_list().iter().position(|e| *e == [0, 1]).unwrap();
     assert!(out.points[8 + e01].distance(expect) < 1e-15);
 }
@@ -275,12 +279,18 @@ fn locked_edges_stay_fixed_for_l_iterations() {
         assert_eq!(on_segment.len(), n + 1, "iteration {k}");
         for j in 0..=n {
             let x = j as f64 / n as f64;
-            assert!(on_segment.contains(&x), "iteration {k}: no point at x = {x}");
+            assert!(
+                on_segment.contains(&x),
+                "iteration {k}: no point at x = {x}"
+            );
         }
         // Everything else moved as in Catmull–Clark (away from the cube corners).
         let plain = catmull_clark(&mesh, k, &Features::default()).unwrap();
         assert_ne!(plain.points[0], out.points[0]);
-        assert_eq!(plain.points[7], out.points[7], "far corner is not affected in iteration {k}");
+        assert_eq!(
+            plain.points[7], out.points[7],
+            "far corner is not affected in iteration {k}"
+        );
     }
     let three = catmull_clark_weighted(&mesh, 3, &cfg, &Features::default()).unwrap();
     assert_ne!(three.points[0], DVec3::ZERO);
@@ -361,7 +371,9 @@ fn json_configuration_reads_and_reports_errors_by_line() {
 
     let bad = dir.path().join("bad.json");
     std::fs::write(&bad, "{\n  \"iterations\": [],\n  \"face_extrud\": 1\n}\n").unwrap();
-    let e = WeightedConfig::from_json_file(&bad).unwrap_err().to_string();
+    let e = WeightedConfig::from_json_file(&bad)
+        .unwrap_err()
+        .to_string();
     assert!(e.starts_with(&format!("{}:3:", bad.display())), "{e}");
     assert!(e.contains("face_extrud"), "{e}");
 
