@@ -60,12 +60,12 @@ fn boundary_edges_loops_and_rings() {
     assert!(!boundary);
     assert_eq!(ring.len(), 6);
     let c = m.points[4];
-    let mut last = None;
+    let mut last: Option<f64> = None;
     for w in ring.iter().chain(ring.first()) {
         let d = m.points[*w as usize] - c;
         let a = d.y.atan2(d.x);
         if let Some(prev) = last {
-            let step = (a - prev as f64).rem_euclid(2.0 * std::f64::consts::PI);
+            let step = (a - prev).rem_euclid(2.0 * std::f64::consts::PI);
             assert!(
                 step > 0.0 && step < std::f64::consts::PI,
                 "not counter-clockwise"

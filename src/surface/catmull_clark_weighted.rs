@@ -21,7 +21,7 @@
 //! 2. Edge point: E = ((F₁ + F₂)(1 + w_e) + (P₁ + P₂)(1 − w_e))/4 + n_e·w,
 //!    w_e = `edge`, w = `edge_extrude`.
 //! 3. Vertex point of valence i: V = (F̄(1 + w_v) + 2R̄(1 − w_v/2) + (i − 3)P)/i
-//!    + n_v·w, w_v = `vertex`, w = `vertex_extrude`, F̄ the average of the
+//!    \+ n_v·w, w_v = `vertex`, w = `vertex_extrude`, F̄ the average of the
 //!    new face points around, R̄ the average of the midpoints of the edges.
 //! 4. Attraction/deflection (eqs. 10, 11): F ← F + w₆ Σ (Pₖ − F) μ(Pₖ)/n and
 //!    E ← E + w₇ ((P₁ − E) μ(P₁) + (P₂ − E) μ(P₂)), w₆ = `face_attract`,

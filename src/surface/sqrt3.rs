@@ -495,8 +495,8 @@ fn interior_face_point(
     // are closed, as no curve edge ends at a smooth vertex).
     let mut p = DVec3::ZERO;
     let mut n = 0;
-    for i in 0..3 {
-        if topo.kind[tri[i] as usize] == VertexKind::Smooth {
+    for (i, &v) in tri.iter().enumerate() {
+        if topo.kind[v as usize] == VertexKind::Smooth {
             p += vertex_stencil(topo, points, tris, t, i)?;
             n += 1;
         }
