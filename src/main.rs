@@ -19,6 +19,8 @@ enum Command {
     Quality(cli::quality::Args),
     /// Convert a mesh between formats, keeping regions, markers and features.
     Convert(cli::convert::Args),
+    /// Subdivide a polygon surface (√3, Loop, Catmull–Clark, Doo–Sabin, weighted Catmull–Clark).
+    Surface(cli::surface::Args),
 }
 
 fn main() -> ExitCode {
@@ -26,6 +28,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Quality(a) => cli::quality::run(a),
         Command::Convert(a) => cli::convert::run(a),
+        Command::Surface(a) => cli::surface::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

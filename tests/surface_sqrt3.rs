@@ -431,9 +431,72 @@ fn bad_input_is_refused_with_a_reason() {
     .unwrap_err();
     assert!(e.to_string().contains("orientations disagree"), "{e}");
     let opts = Sqrt3Options {
-        creases: vec![[0, 1]],
+        features: tetrefine::surface::features::Features {
+            creases: vec![[0, 1]],
+            ..Default::default()
+        },
         ..Default::default()
     };
     let e = sqrt3(&octahedron(), Sqrt3Rule::Approximating, 1, &opts).unwrap_err();
     assert!(e.to_string().contains("not an edge"), "{e}");
+}
+
+#[test]
+fn points_in_no_triangle_are_left_alone() {
+    let mut m = icosahedron();
+    let lonely = DVec3::new(7.0, 8.0, 9.0);
+    m.points.push(lonely);
+    for rule in [
+        Sqrt3Rule::Approximating,
+        Sqrt3Rule::Interpolating,
+        Sqrt3Rule::Linear,
+    ] {
+        let pos = sqrt3_positions(&m.points, &tris(&m), rule, &HashSet::new(), &HashSet::new());
+        assert_eq!(pos.vertices.len(), m.points.len());
+        assert_eq!(pos.faces.len(), m.faces.len());
+        assert_eq!(pos.vertices[12], lonely);
+    }
+}
+
+#[test]
+fn cube_edges_found_by_angle_stay_straight_and_corners_stay() {
+    // The cube cut into triangles; --crease-angle 45 tags exactly its 12
+    // edges; each cube corner has three crease edges, so it is a corner.
+    let q = cube();
+    let mut faces = Vec::new();
+    for f in &q.faces {
+        faces.push(vec![f[0], f[1], f[2]]);
+        faces.push(vec![f[0], f[2], f[3]]);
+    }
+    let mesh = PolyMesh::new(q.points.clone(), faces);
+    let opts = Sqrt3Options {
+        features: tetrefine::surface::features::Features {
+            crease_angle: Some(45.0),
+            ..Default::default()
+        },
+        ..Default::default()
+    };
+    let out = sqrt3(&mesh, Sqrt3Rule::Approximating, 4, &opts).unwrap();
+    out.validate().unwrap();
+    for v in 0..8 {
+        assert_eq!(out.points[v], mesh.points[v]);
+    }
+    // Every point stays in the cube; points on its edges stay on them: a
+    // point with two coordinates in {0, 1} is on a cube edge. Along each
+    // original edge, 3² = 9 segments after four steps.
+    let on_edge = out
+        .points
+        .iter()
+        .filter(|p| {
+            p.to_array()
+                .iter()
+                .filter(|c| **c == 0.0 || **c == 1.0)
+                .count()
+                >= 2
+        })
+        .count();
+    assert_eq!(on_edge, 8 + 12 * 8);
+    for p in &out.points {
+        assert!(p.cmpge(DVec3::splat(-1e-12)).all() && p.cmple(DVec3::splat(1.0 + 1e-12)).all());
+    }
 }

@@ -3,6 +3,7 @@
 
 pub mod convert;
 pub mod quality;
+pub mod surface;
 
 /// A one-line error for the user.
 pub type CliResult = Result<(), String>;

@@ -1,14 +1,29 @@
 //! Secondary module: polygon-mesh subdivision schemes of the seed papers and
 //! the √3 stencils shared with the tetrahedral step.
+//!
+//! * [`polymesh`]: the indexed polygon mesh, its half-edge adjacency,
+//!   validation, components, Euler characteristic and genus;
+//! * [`io`] and one module per format ([`obj`], [`off`], [`ply`], [`vtp`],
+//!   [`vtk_legacy`]);
+//! * schemes: [`sqrt3`] (Kobbelt; Labsik–Greiner), [`loop_scheme`] (Loop),
+//!   [`catmull_clark`], [`doo_sabin`], [`catmull_clark_weighted`]
+//!   (Hansmeyer's weighted and extruded Catmull–Clark), all with tagged
+//!   creases and corners through [`features`].
 
+pub mod catmull_clark;
+pub mod catmull_clark_weighted;
+pub mod doo_sabin;
+pub mod features;
 pub mod io;
+pub mod loop_scheme;
 pub mod obj;
 pub mod off;
 pub mod ply;
 pub mod polymesh;
+pub mod sqrt3;
 pub mod vtk_legacy;
 pub mod vtp;
 
+pub use features::{Features, SubdivisionError};
 pub use io::{load_surface, read_surface, write_surface, SurfaceFile, SurfaceFormat};
 pub use polymesh::{Component, HalfEdges, PolyMesh, TopologyError, NO_TWIN};
-pub mod sqrt3;

@@ -38,8 +38,8 @@
 //!   special boundary stencils of the paper; along a curve, the trisection
 //!   points follow the interpolating four-point ternary rule
 //!   (−5/81, 20/27, 10/27, −4/81). Where a stencil would cross a curve edge
-//!   the face point falls back to the one-sided K = 6 stencil of its smooth
-//!   vertices, or to the centroid.
+//!   the face point falls back to the average of the K = 6 stencils of its
+//!   smooth vertices, or to the centroid.
 //! * [`Sqrt3Rule::Linear`]: old vertices stay, face points at centroids,
 //!   trisection points at the thirds: pure topological refinement.
 //!
@@ -53,12 +53,12 @@
 //! of the triangle intact. An old vertex moves only when all of its triangles
 //! were split, so unrefined regions keep their geometry.
 
-use super::polymesh::{PolyMesh, TopologyError};
+use super::features::{Features, SubdivisionError};
+use super::polymesh::PolyMesh;
 use glam::DVec3;
 use rayon::prelude::*;
 use std::collections::{HashMap, HashSet};
 use std::f64::consts::PI;
-use std::fmt;
 
 /// Which geometric rule a √3 step uses.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -495,8 +495,8 @@ fn interior_face_point(
     // are closed, as no curve edge ends at a smooth vertex).
     let mut p = DVec3::ZERO;
     let mut n = 0;
-    for i in 0..3 {
-        if topo.kind[tri[i] as usize] == VertexKind::Smooth {
+    for (i, &v) in tri.iter().enumerate() {
+        if topo.kind[v as usize] == VertexKind::Smooth {
             p += vertex_stencil(topo, points, tris, t, i)?;
             n += 1;
         }
@@ -619,13 +619,8 @@ impl FaceSelection {
 /// Options of [`sqrt3`] beyond the rule and the number of steps.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Sqrt3Options {
-    /// Tagged crease edges (vertex pairs of the input, any order).
-    pub creases: Vec<[u32; 2]>,
-    /// Tagged corner vertices of the input.
-    pub corners: Vec<u32>,
-    /// Also tag every edge whose two face normals differ by more than this
-    /// angle (degrees).
-    pub crease_angle: Option<f64>,
+    /// Tagged creases and corners.
+    pub features: Features,
     /// Which triangles are split in each step.
     pub selection: FaceSelection,
 }
@@ -633,49 +628,11 @@ pub struct Sqrt3Options {
 impl Default for Sqrt3Options {
     fn default() -> Self {
         Sqrt3Options {
-            creases: Vec::new(),
-            corners: Vec::new(),
-            crease_angle: None,
+            features: Features::default(),
             selection: FaceSelection::All,
         }
     }
 }
-
-/// Why [`sqrt3`] refused a mesh.
-#[derive(Clone, Debug, PartialEq)]
-pub enum Sqrt3Error {
-    /// A face that is not a triangle.
-    NotTriangles {
-        /// The face.
-        face: usize,
-        /// Its number of vertices.
-        len: usize,
-    },
-    /// The mesh is not an oriented manifold.
-    Topology(TopologyError),
-    /// A tagged crease that is not an edge of the mesh.
-    NoSuchEdge([u32; 2]),
-    /// A tagged corner that is not a vertex of the mesh.
-    NoSuchVertex(u32),
-}
-
-impl fmt::Display for Sqrt3Error {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            Sqrt3Error::NotTriangles { face, len } => write!(
-                f,
-                "√3 subdivision needs a triangle mesh, but face {face} has {len} vertices"
-            ),
-            Sqrt3Error::Topology(e) => write!(f, "{e}"),
-            Sqrt3Error::NoSuchEdge(e) => {
-                write!(f, "crease {}-{} is not an edge of the mesh", e[0], e[1])
-            }
-            Sqrt3Error::NoSuchVertex(v) => write!(f, "corner {v} is not a vertex of the mesh"),
-        }
-    }
-}
-
-impl std::error::Error for Sqrt3Error {}
 
 /// A triangle surface under √3 refinement, with its tags and its step count
 /// (which decides whether the next step keeps or trisects curve edges).
@@ -866,30 +823,6 @@ impl Sqrt3Surface {
     }
 }
 
-/// Edges whose two face normals differ by more than `angle_deg` degrees.
-pub fn edges_sharper_than(mesh: &PolyMesh, angle_deg: f64) -> Result<Vec<[u32; 2]>, TopologyError> {
-    let he = mesh.half_edges()?;
-    let cos_max = angle_deg.to_radians().cos();
-    let normals: Vec<DVec3> = (0..mesh.faces.len())
-        .map(|f| mesh.face_newell(f).normalize_or_zero())
-        .collect();
-    let mut out = Vec::new();
-    for (e, &h) in he.edge_half.iter().enumerate() {
-        let t = he.twin[h as usize];
-        if t == super::polymesh::NO_TWIN {
-            continue;
-        }
-        let (a, b) = (
-            normals[he.face[h as usize] as usize],
-            normals[he.face[t as usize] as usize],
-        );
-        if a.dot(b) < cos_max {
-            out.push(he.edges[e]);
-        }
-    }
-    Ok(out)
-}
-
 /// `steps` √3 steps of a triangle mesh with `rule` (Kobbelt's approximating,
 /// Labsik–Greiner's interpolating, or linear), honouring tagged creases and
 /// corners, open boundaries and an adaptive selection. The mesh must be an
@@ -900,34 +833,15 @@ pub fn sqrt3(
     rule: Sqrt3Rule,
     steps: usize,
     options: &Sqrt3Options,
-) -> Result<PolyMesh, Sqrt3Error> {
-    let tris = mesh.triangles().map_err(|f| Sqrt3Error::NotTriangles {
-        face: f,
-        len: mesh.faces[f].len(),
-    })?;
-    let he = mesh.half_edges().map_err(Sqrt3Error::Topology)?;
-    let edge_set: HashSet<[u32; 2]> = he.edges.iter().copied().collect();
-    let mut creases = HashSet::new();
-    for &[a, b] in &options.creases {
-        let e = sorted(a, b);
-        if !edge_set.contains(&e) {
-            return Err(Sqrt3Error::NoSuchEdge(e));
-        }
-        creases.insert(e);
-    }
-    if let Some(angle) = options.crease_angle {
-        for e in edges_sharper_than(mesh, angle).map_err(Sqrt3Error::Topology)? {
-            creases.insert(e);
-        }
-    }
-    let mut corners = HashSet::new();
-    for &c in &options.corners {
-        if c as usize >= mesh.points.len() || he.vertex_out[c as usize] == super::polymesh::NO_TWIN
-        {
-            return Err(Sqrt3Error::NoSuchVertex(c));
-        }
-        corners.insert(c);
-    }
+) -> Result<PolyMesh, SubdivisionError> {
+    let tris = mesh
+        .triangles()
+        .map_err(|f| SubdivisionError::NotTriangles {
+            face: f,
+            len: mesh.faces[f].len(),
+        })?;
+    let he = mesh.half_edges()?;
+    let (creases, corners) = options.features.resolve(mesh, &he)?;
     let mut s = Sqrt3Surface {
         points: mesh.points.clone(),
         tris,
