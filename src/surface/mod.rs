@@ -3,4 +3,16 @@
 
 pub mod polymesh;
 
+mod closed_manifold;
+pub mod error;
+pub mod ifs;
+pub mod sierpinski;
+#[cfg(test)]
+mod test_shapes;
+pub mod truncate;
+
+pub use error::SurfaceError;
+pub use ifs::{ifs_attractor, Ifs, IfsKind};
 pub use polymesh::PolyMesh;
+pub use sierpinski::sierpinski;
+pub use truncate::truncate;
