@@ -188,7 +188,7 @@ impl Ifs {
             }
             IfsKind::Bicubic { nu, nv } => {
                 need(
-                    nu >= 4 && nv >= 4 && n == nu * nv,
+                    nu >= 4 && nv >= 4 && nu.checked_mul(nv) == Some(n),
                     "a grid of at least 4 × 4",
                 )?;
                 let su = split_rows(&bspline_refinement(nu), nu, &[0, nu - 3]);
@@ -243,7 +243,8 @@ impl Ifs {
         &self.maps[i]
     }
 
-    /// `f_i(w) = w S_i`.
+    /// `f_i(w) = w S_i` (`w` has [`Ifs::dimension`] entries; missing ones
+    /// count as 0, extra ones are ignored).
     pub fn apply(&self, i: usize, w: &[f64]) -> Vec<f64> {
         let mut out = vec![0.0; self.m];
         row_times(w, &self.maps[i], self.m, &mut out);
@@ -336,6 +337,13 @@ impl Ifs {
         k: usize,
         mut visit: impl FnMut(usize, DVec3),
     ) -> Result<(), SurfaceError> {
+        if let Some(w) = start.iter().find(|w| w.len() != self.m) {
+            return Err(SurfaceError::Parameter(format!(
+                "a start point has {} weights; this IFS has {} control points",
+                w.len(),
+                self.m
+            )));
+        }
         let n = self.map_count();
         let total = start.len() as f64 * (n as f64).powi(k.min(1000) as i32);
         if total > MAX_POINTS {
@@ -353,20 +361,12 @@ impl Ifs {
         }
         let set = self.iterate_set(start, inner);
         let outer = k - inner;
-        let mut identity = vec![0.0; self.m * self.m];
-        for j in 0..self.m {
-            identity[j * self.m + j] = 1.0;
-        }
-        let mut stack = vec![identity];
-        let mut q = vec![DVec3::ZERO; self.m];
-        self.walk_prefixes(outer, 0, &mut stack, &mut |prefix, t| {
-            for (r, qr) in q.iter_mut().enumerate() {
-                *qr = (0..self.m)
-                    .map(|c| t[r * self.m + c] * self.control[c])
-                    .sum();
-            }
+        // Q = S_(i_k1) ⋯ S_(i_1) P, the control points of the piece with that
+        // address, carried down the tree (m² work per node).
+        let mut stack = vec![self.control.clone()];
+        self.walk_prefixes(outer, 0, &mut stack, &mut |prefix, q| {
             for (idx, u) in set.iter().enumerate() {
-                let x: DVec3 = u.iter().zip(&q).map(|(&a, &p)| a * p).sum();
+                let x: DVec3 = u.iter().zip(q).map(|(&a, &p)| a * p).sum();
                 visit(prefix * set.len() + idx, x);
             }
         });
@@ -377,16 +377,26 @@ impl Ifs {
         &self,
         depth: usize,
         prefix: usize,
-        stack: &mut Vec<Vec<f64>>,
-        leaf: &mut impl FnMut(usize, &[f64]),
+        stack: &mut Vec<Vec<DVec3>>,
+        leaf: &mut impl FnMut(usize, &[DVec3]),
     ) {
         if depth == 0 {
-            leaf(prefix, stack.last().expect("stack holds the identity"));
+            leaf(
+                prefix,
+                stack.last().expect("stack holds the control points"),
+            );
             return;
         }
         for i in 0..self.map_count() {
-            let t = mat_mul(&self.maps[i], stack.last().expect("non-empty"), self.m);
-            stack.push(t);
+            let q = stack.last().expect("stack holds the control points");
+            let s = &self.maps[i];
+            let next: Vec<DVec3> = (0..self.m)
+                .map(|r| {
+                    let row = &s[r * self.m..(r + 1) * self.m];
+                    row.iter().zip(q).map(|(&a, &p)| a * p).sum()
+                })
+                .collect();
+            stack.push(next);
             self.walk_prefixes(depth - 1, prefix * self.map_count() + i, stack, leaf);
             stack.pop();
         }
@@ -776,7 +786,7 @@ fn eighths(s: &[[i8; 6]; 6]) -> Vec<f64> {
 /// `out = w A` for a row vector `w` and row-major `m × m` `A`.
 fn row_times(w: &[f64], a: &[f64], m: usize, out: &mut [f64]) {
     out.iter_mut().for_each(|x| *x = 0.0);
-    for (r, &wr) in w.iter().enumerate() {
+    for (r, &wr) in w.iter().take(m).enumerate() {
         if wr != 0.0 {
             for (o, &x) in out.iter_mut().zip(&a[r * m..(r + 1) * m]) {
                 *o += wr * x;
@@ -1589,6 +1599,12 @@ mod tests {
             ifs_attractor(IfsKind::Koch, &koch_control(), 40),
             Err(SurfaceError::TooLarge { .. })
         ));
+        let koch = Ifs::new(IfsKind::Koch, &koch_control()).expect("ifs");
+        assert!(matches!(
+            koch.for_each_point(&[vec![1.0; 3]], 2, |_, _| {}),
+            Err(SurfaceError::Parameter(_))
+        ));
+        assert_eq!(koch.apply(0, &[1.0; 9]), koch.apply(0, &[1.0; 5]));
         let msg = Ifs::new(IfsKind::FourPoint, &four).unwrap_err().to_string();
         assert_eq!(msg, "FourPoint needs at least 6 control points, got 4");
     }
