@@ -8,7 +8,10 @@
 //! * schemes: [`sqrt3`] (Kobbelt; Labsik–Greiner), [`loop_scheme`] (Loop),
 //!   [`catmull_clark`], [`doo_sabin`], [`catmull_clark_weighted`]
 //!   (Hansmeyer's weighted and extruded Catmull–Clark), all with tagged
-//!   creases and corners through [`features`].
+//!   creases and corners through [`features`];
+//! * the seed papers' other constructions: [`sierpinski`] (Sierpinski
+//!   polyhedra), [`truncate`] (Chaikin vertex truncation) and [`ifs`]
+//!   (subdivision as iterated function systems).
 
 pub mod catmull_clark;
 pub mod catmull_clark_weighted;
@@ -24,6 +27,18 @@ pub mod sqrt3;
 pub mod vtk_legacy;
 pub mod vtp;
 
+mod closed_manifold;
+pub mod error;
+pub mod ifs;
+pub mod sierpinski;
+#[cfg(test)]
+mod test_shapes;
+pub mod truncate;
+
+pub use error::SurfaceError;
 pub use features::{Features, SubdivisionError};
+pub use ifs::{ifs_attractor, Ifs, IfsKind};
 pub use io::{load_surface, read_surface, write_surface, SurfaceFile, SurfaceFormat};
 pub use polymesh::{Component, HalfEdges, PolyMesh, TopologyError, NO_TWIN};
+pub use sierpinski::sierpinski;
+pub use truncate::truncate;

@@ -1,0 +1,92 @@
+//! [`SurfaceError`]: why a surface scheme refused its input.
+
+use thiserror::Error;
+
+/// Why a surface scheme (Sierpinski, truncation, IFS) refused its input.
+///
+/// Every message is one line and names the offending face, edge or vertex by
+/// its 0-based id in the input.
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum SurfaceError {
+    /// A face has fewer than three vertices.
+    #[error("face {face} has {len} vertices; a face needs at least 3")]
+    FaceTooSmall {
+        /// The face.
+        face: usize,
+        /// Its number of vertices.
+        len: usize,
+    },
+    /// A face refers to a vertex that does not exist.
+    #[error("face {face} refers to vertex {vertex}, but the mesh has {count} vertices")]
+    VertexOutOfRange {
+        /// The face.
+        face: usize,
+        /// The bad vertex id.
+        vertex: u32,
+        /// Number of vertices in the mesh.
+        count: usize,
+    },
+    /// A face visits the same vertex twice.
+    #[error("face {face} visits vertex {vertex} twice")]
+    RepeatedVertex {
+        /// The face.
+        face: usize,
+        /// The repeated vertex.
+        vertex: u32,
+    },
+    /// A vertex has a coordinate that is NaN or infinite.
+    #[error("vertex {vertex} has a non-finite coordinate")]
+    NonFinite {
+        /// The vertex.
+        vertex: usize,
+    },
+    /// Two faces use the same directed edge: the edge is shared by more than
+    /// two faces, or its two faces are not consistently oriented.
+    #[error(
+        "edge {from}->{to} is used in the same direction by faces {first} and {second}: \
+         the faces are not consistently oriented or the edge is non-manifold"
+    )]
+    EdgeOrientation {
+        /// Start vertex of the edge.
+        from: u32,
+        /// End vertex of the edge.
+        to: u32,
+        /// The first face using it.
+        first: usize,
+        /// The second face using it.
+        second: usize,
+    },
+    /// An edge lies in one face only: the surface has a boundary.
+    #[error("edge {from}-{to} lies in face {face} only: the surface has a boundary, and this scheme needs a closed surface")]
+    OpenEdge {
+        /// Start vertex of the edge in its face.
+        from: u32,
+        /// End vertex of the edge in its face.
+        to: u32,
+        /// The face.
+        face: usize,
+    },
+    /// The faces around a vertex form more than one fan (a pinched vertex).
+    #[error("vertex {vertex} is non-manifold: its faces form more than one fan")]
+    NonManifoldVertex {
+        /// The vertex.
+        vertex: u32,
+    },
+    /// The input has no faces.
+    #[error("the mesh has no faces")]
+    Empty,
+    /// The requested number of steps would create more elements than 32-bit
+    /// ids can count.
+    #[error("{steps} steps would create about {estimate} {what}, more than this scheme supports")]
+    TooLarge {
+        /// The number of steps asked for.
+        steps: usize,
+        /// The estimated count.
+        estimate: f64,
+        /// What would overflow (vertices, faces, points).
+        what: &'static str,
+    },
+    /// A parameter is out of its range.
+    #[error("{0}")]
+    Parameter(String),
+}
