@@ -13,8 +13,8 @@
 //!
 //! The writer puts every region in its own volume entity with that region as
 //! physical tag, every face marker in a surface entity, every edge marker in a
-//! curve entity and every corner in a point entity, so that Gmsh and meshio read
-//! the tags back.
+//! curve entity and every corner in a point entity (physical tag 1), so that
+//! Gmsh and meshio read the tags back.
 
 use super::{drop_unused_points, read_bytes, write_atomic, IoError};
 use crate::mesh::{MeshData, TetMesh};
@@ -812,6 +812,11 @@ pub fn write(path: &Path, mesh: &TetMesh) -> Result<(), IoError> {
     write_data(path, &mesh.to_data())
 }
 
+/// Physical tag of the point entities that carry corners: corners have no
+/// marker of their own, but meshio needs every entity to have a physical tag
+/// once any has one.
+const CORNER_PHYSICAL: i32 = 1;
+
 /// One entity of the written file: its physical tag and the elements in it.
 struct Entity<E> {
     physical: i32,
@@ -875,7 +880,14 @@ pub fn write_data(path: &Path, d: &MeshData) -> Result<(), IoError> {
         )?;
         for (i, &v) in corners.iter().enumerate() {
             let p = d.points[v as usize];
-            writeln!(w, "{} {:?} {:?} {:?} 0", i + 1, p[0], p[1], p[2])?;
+            writeln!(
+                w,
+                "{} {:?} {:?} {:?} 1 {CORNER_PHYSICAL}",
+                i + 1,
+                p[0],
+                p[1],
+                p[2]
+            )?;
         }
         let write_box = |w: &mut dyn Write, tag: usize, b: [f64; 6], physical: i32| {
             writeln!(
