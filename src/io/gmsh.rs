@@ -126,6 +126,15 @@ impl<'a> Cursor<'a> {
         }
     }
 
+    /// An error about the item read at `line` / `pos` (a section header).
+    fn error_at(&self, line: usize, pos: usize, message: impl Into<String>) -> IoError {
+        if self.binary {
+            IoError::file(self.path, format!("at byte {pos}: {}", message.into()))
+        } else {
+            IoError::at(self.path, line, message)
+        }
+    }
+
     fn eof_error(&self, what: &str) -> IoError {
         let message = format!("file ends where {what} was expected (truncated?)");
         if self.binary {
@@ -705,6 +714,7 @@ fn read_nodes_v41(c: &mut Cursor, col: &mut Collector) -> Result<(), IoError> {
     let n = c.count("the node count", 8)?;
     let _min = c.size("the smallest node tag")?;
     let _max = c.size("the largest node tag")?;
+    let (header_line, header_pos) = (c.last_line, c.last_pos);
     let mut tags: Vec<u64> = Vec::with_capacity(n);
     let mut coords: Vec<[f64; 3]> = Vec::with_capacity(n);
     for _ in 0..nblocks {
@@ -735,10 +745,14 @@ fn read_nodes_v41(c: &mut Cursor, col: &mut Collector) -> Result<(), IoError> {
         }
     }
     if tags.len() != n {
-        return Err(c.error(format!(
-            "node blocks hold {} nodes but the header announced {n}",
-            tags.len()
-        )));
+        return Err(c.error_at(
+            header_line,
+            header_pos,
+            format!(
+                "node blocks hold {} nodes but the header announced {n}",
+                tags.len()
+            ),
+        ));
     }
     end_section(c, "$EndNodes")?;
     col.set_nodes(c, &tags, coords)
@@ -756,6 +770,7 @@ fn read_elements_v41(
     let n = c.count("the element count", 8)?;
     let _min = c.size("the smallest element tag")?;
     let _max = c.size("the largest element tag")?;
+    let (header_line, header_pos) = (c.last_line, c.last_pos);
     let mut total = 0usize;
     for _ in 0..nblocks {
         let dim = c.int("an entity dimension")?;
@@ -800,9 +815,11 @@ fn read_elements_v41(
         }
     }
     if total != n {
-        return Err(c.error(format!(
-            "element blocks hold {total} elements but the header announced {n}"
-        )));
+        return Err(c.error_at(
+            header_line,
+            header_pos,
+            format!("element blocks hold {total} elements but the header announced {n}"),
+        ));
     }
     end_section(c, "$EndElements")
 }

@@ -49,7 +49,13 @@ pub fn read(path: &Path) -> Result<MeshData, IoError> {
 }
 
 fn load(path: &Path) -> Result<Vec<u8>, IoError> {
-    let bytes = std::fs::read(path).map_err(|e| IoError::file(path, open_message(&e)))?;
+    let bytes = std::fs::read(path).map_err(|e| {
+        let mut m = open_message(&e);
+        if e.kind() == std::io::ErrorKind::NotFound {
+            m.push_str(" (a TetGen mesh needs both its .node and its .ele file)");
+        }
+        IoError::file(path, m)
+    })?;
     if bytes.iter().all(|c| c.is_ascii_whitespace()) {
         return Err(IoError::file(path, "empty file"));
     }

@@ -30,6 +30,7 @@ impl<'a> Tokens<'a> {
     }
 
     /// Line of the token returned last.
+    #[allow(clippy::misnamed_getters)] // `line` is where the cursor is; this is the token's
     pub fn line(&self) -> usize {
         self.last_line
     }

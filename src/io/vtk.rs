@@ -132,7 +132,7 @@ fn data_array<T: LeBytes>(
     values: &[T],
     extra_attrs: &str,
 ) -> std::io::Result<()> {
-    let mut raw = Vec::with_capacity(values.len() * std::mem::size_of::<T>());
+    let mut raw = Vec::with_capacity(std::mem::size_of_val(values));
     for &v in values {
         v.put(&mut raw);
     }
@@ -622,7 +622,7 @@ impl Layout<'_> {
                 "compressed array header announces an impossible size (corrupt)",
             ));
         }
-        let mut out = Vec::with_capacity(total);
+        let mut out = Vec::with_capacity(total.min(s.len().saturating_mul(8)));
         for (i, &cs) in sizes.iter().enumerate() {
             let want = if i + 1 == blocks && last != 0 {
                 last
@@ -651,12 +651,9 @@ impl Layout<'_> {
 
     /// Values of a DataArray element.
     fn values(&self, e: &Element) -> Result<(Values, usize), IoError> {
-        let err = |m: &str| {
-            IoError::at(
-                self.path,
-                e.line,
-                format!("DataArray '{}': {m}", e.attr("Name").unwrap_or("")),
-            )
+        let err = |m: &str| match e.attr("Name") {
+            Some(n) => IoError::at(self.path, e.line, format!("DataArray '{n}': {m}")),
+            None => IoError::at(self.path, e.line, format!("DataArray: {m}")),
         };
         let ty = e.attr("type").ok_or_else(|| err("no type attribute"))?;
         let scalar = Scalar::parse(ty).ok_or_else(|| err(&format!("unsupported type '{ty}'")))?;
