@@ -129,6 +129,10 @@ fn truncated_and_corrupted_files_never_panic() {
     for n in [
         "tests/data/mmg_cube_v41_binary.msh",
         "tests/data/mmg_cube_v22_binary.msh",
+        "tests/data/mmg_cube_vtk_ascii.vtu",
+        "tests/data/mmg_cube_vtk_appended_raw.vtu",
+        "tests/data/mmg_cube_vtk_appended_base64_zlib.vtu",
+        "tests/data/tetgen_example.1.face",
     ] {
         sources.push(root.join(n));
     }
@@ -149,12 +153,13 @@ fn truncated_and_corrupted_files_never_panic() {
         let bytes = std::fs::read(src).unwrap();
         let name = src.file_name().unwrap().to_string_lossy().into_owned();
         let target = work.path().join(&name);
-        // TetGen: corrupt the named file, keep its sibling intact.
-        if name.ends_with(".ele") {
-            std::fs::copy(dir.path().join("own.node"), work.path().join("own.node")).unwrap();
-        }
-        if name.ends_with(".node") {
-            std::fs::copy(dir.path().join("own.ele"), work.path().join("own.ele")).unwrap();
+        // TetGen: corrupt the named file, keep its siblings intact.
+        for ext in ["node", "ele", "face", "edge"] {
+            let sibling = src.with_extension(ext);
+            if sibling != *src && sibling.exists() {
+                let to = work.path().join(sibling.file_name().unwrap());
+                std::fs::copy(&sibling, to).unwrap();
+            }
         }
         for k in 0..CUTS {
             let cut = bytes.len() * k / CUTS;

@@ -184,3 +184,24 @@ fn binary_gmsh_files_written_by_gmsh_match_the_medit_original() {
         }
     }
 }
+
+#[test]
+fn vtu_files_in_every_layout_written_by_vtk_match_the_medit_original() {
+    let original = load(&mesh_path("mmg_cube.mesh"));
+    let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data");
+    for layout in [
+        "ascii",
+        "appended_raw",
+        "appended_base64_zlib",
+        "inline_raw",
+    ] {
+        let path = data.join(format!("mmg_cube_vtk_{layout}.vtu"));
+        let (got, report) = load_mesh(&path).unwrap();
+        assert_eq!(report.reoriented, 0, "{layout}");
+        assert_eq!(got.points(), original.points(), "{layout}: points");
+        assert!(
+            canon(&got).tets == canon(&original).tets,
+            "{layout}: tets differ"
+        );
+    }
+}
