@@ -19,6 +19,7 @@ const CASES: &[(&str, Option<usize>, &str)] = &[
     ("overlap.mesh", Some(13), "overlaps"),
     ("nan.msh", Some(8), "NaN"),
     ("duplicate_tet.msh", Some(16), "duplicates"),
+    ("extra_node.msh", Some(14), "more than 4 nodes"),
     ("missing_nodes.msh", Some(6), "$Nodes"),
     ("bad_version.msh", Some(2), "3.0"),
     ("undefined_node_v41.msh", Some(19), "42"),

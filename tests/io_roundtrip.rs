@@ -205,3 +205,48 @@ fn vtu_files_in_every_layout_written_by_vtk_match_the_medit_original() {
         );
     }
 }
+
+/// Gmsh node tags need not be 1..n nor in order: a hand-written file in MSH
+/// 2.2 and 4.1 with tags 50, 10, 40, 20, 30 (and a line, a triangle and a
+/// point element with physical tags) reads as the mesh it describes.
+#[test]
+fn sparse_gmsh_node_tags_are_mapped() {
+    let dir = tempfile::tempdir().unwrap();
+    // tag -> point: 10 (0,0,0), 20 (1,0,0), 30 (0,1,0), 40 (0,0,1), 50 (1,1,1)
+    let v22 = "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n5\n\
+               50 1 1 1\n10 0 0 0\n40 0 0 1\n20 1 0 0\n30 0 1 0\n$EndNodes\n\
+               $Elements\n5\n\
+               7 15 2 5 1 10\n8 1 2 6 1 10 20\n9 2 2 7 1 10 20 30\n\
+               100 4 2 3 1 10 20 30 40\n101 4 2 4 1 20 30 40 50\n$EndElements\n";
+    let v41 = "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Entities\n1 1 1 2\n\
+               1 0 0 0 1 5\n1 0 0 0 1 0 0 1 6 0\n1 0 0 0 1 1 0 1 7 0\n1 0 0 0 1 1 1 1 3 0\n2 0 0 0 1 1 1 1 4 0\n$EndEntities\n\
+               $Nodes\n2 5 10 50\n3 2 0 3\n50\n10\n40\n1 1 1\n0 0 0\n0 0 1\n3 2 0 2\n20\n30\n1 0 0\n0 1 0\n$EndNodes\n\
+               $Elements\n5 5 7 101\n0 1 15 1\n7 10\n1 1 1 1\n8 10 20\n2 1 2 1\n9 10 20 30\n\
+               3 1 4 1\n100 10 20 30 40\n3 2 4 1\n101 20 30 40 50\n$EndElements\n";
+    let p = |x: f64, y: f64, z: f64| [x, y, z].map(f64::to_bits);
+    let (a, b, c, d, e) = (
+        p(0., 0., 0.),
+        p(1., 0., 0.),
+        p(0., 1., 0.),
+        p(0., 0., 1.),
+        p(1., 1., 1.),
+    );
+    let mut tets = vec![([a, b, c, d], 3), ([b, c, d, e], 4)];
+    for (t, _) in tets.iter_mut() {
+        t.sort_unstable();
+    }
+    tets.sort_unstable();
+    for (name, text) in [("v22.msh", v22), ("v41.msh", v41)] {
+        let path = dir.path().join(name);
+        std::fs::write(&path, text).unwrap();
+        let got = canon(&load(&path));
+        assert_eq!(got.tets, tets, "{name}");
+        let mut abc = [a, b, c];
+        abc.sort_unstable();
+        assert_eq!(got.faces, vec![(abc, 7)], "{name}");
+        let mut ab = [a, b];
+        ab.sort_unstable();
+        assert_eq!(got.edges, vec![(ab, 6)], "{name}");
+        assert_eq!(got.corners, vec![a], "{name}");
+    }
+}

@@ -202,6 +202,14 @@ impl<'a> Cursor<'a> {
         }
     }
 
+    /// Whether nothing but blanks is left on the current line.
+    fn rest_of_line_blank(&self) -> bool {
+        self.b[self.pos..]
+            .iter()
+            .take_while(|&&c| c != b'\n')
+            .all(|c| c.is_ascii_whitespace())
+    }
+
     /// Consumes the line end that precedes binary data.
     fn line_end(&mut self) -> Result<(), IoError> {
         while self.pos < self.b.len() && matches!(self.b[self.pos], b' ' | b'\t' | b'\r') {
@@ -655,6 +663,11 @@ fn read_elements_v2(c: &mut Cursor, col: &mut Collector) -> Result<(), IoError> 
                     "element of type {etype} has fewer than {k} nodes on its line"
                 )));
             }
+            if !c.rest_of_line_blank() {
+                return Err(c.error(format!(
+                    "element of type {etype} has more than {k} nodes on its line"
+                )));
+            }
             let r = region_v2(&tags);
             col.add(role, etype, r, c, Some(line))?;
         }
@@ -767,7 +780,7 @@ fn read_elements_v41(
         c.line_end()?;
     }
     let nblocks = c.count("the element block count", 8)?;
-    let n = c.count("the element count", 8)?;
+    let n = c.count("the element count", 4)?;
     let _min = c.size("the smallest element tag")?;
     let _max = c.size("the largest element tag")?;
     let (header_line, header_pos) = (c.last_line, c.last_pos);
@@ -776,7 +789,7 @@ fn read_elements_v41(
         let dim = c.int("an entity dimension")?;
         let tag = c.int("an entity tag")?;
         let etype = c.int("an element type")?;
-        let k = c.count("the element count of a block", 8)?;
+        let k = c.count("the element count of a block", 4)?;
         total += k;
         if total > n {
             return Err(c.error(format!(
@@ -808,6 +821,11 @@ fn read_elements_v41(
             if !c.binary && c.last_line != line {
                 return Err(c.error(format!(
                     "element of type {etype} has fewer than {nodes} nodes on its line"
+                )));
+            }
+            if !c.binary && !c.rest_of_line_blank() {
+                return Err(c.error(format!(
+                    "element of type {etype} has more than {nodes} nodes on its line"
                 )));
             }
             let l = (!c.binary).then_some(line);

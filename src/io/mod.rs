@@ -74,7 +74,7 @@ pub enum Format {
     Gid,
     /// VTK XML unstructured grid `.vtu`.
     Vtu,
-    /// TetGen `.node` / `.ele` / `.face`.
+    /// TetGen `.node` / `.ele` / `.face` / `.edge`.
     Tetgen,
 }
 
@@ -93,16 +93,22 @@ impl Format {
             "vtu" => Ok(Format::Vtu),
             "node" | "ele" | "face" | "edge" => Ok(Format::Tetgen),
             "msh" => {
-                let mut head = [0u8; 64];
-                let n = {
+                let mut head = Vec::with_capacity(4096);
+                {
                     use std::io::Read;
-                    let mut f =
-                        File::open(path).map_err(|e| IoError::file(path, open_message(&e)))?;
-                    f.read(&mut head)
-                        .map_err(|e| IoError::file(path, e.to_string()))?
-                };
-                let text = String::from_utf8_lossy(&head[..n]);
-                let first = text.split_whitespace().next().unwrap_or("");
+                    let f = File::open(path).map_err(|e| IoError::file(path, open_message(&e)))?;
+                    f.take(4096)
+                        .read_to_end(&mut head)
+                        .map_err(|e| IoError::file(path, e.to_string()))?;
+                }
+                // The first word outside GiD's `#` comment lines.
+                let text = String::from_utf8_lossy(&head);
+                let first = text
+                    .lines()
+                    .map(|l| l.split('#').next().unwrap_or(""))
+                    .flat_map(str::split_whitespace)
+                    .next()
+                    .unwrap_or("");
                 if first.eq_ignore_ascii_case("MESH") {
                     Ok(Format::Gid)
                 } else {
