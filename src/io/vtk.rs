@@ -8,7 +8,8 @@
 //! integral values) gives the regions; without it, meshio's `gmsh:physical`,
 //! `medit:ref` or `CellEntityIds` is used if present.
 //!
-//! Written: zlib-compressed inline binary, `UInt64` headers, read by VTK's
+//! Written: zlib-compressed (fastest level: float data hardly compresses
+//! further) inline binary, `UInt64` headers, read by VTK's
 //! `vtkXMLUnstructuredGridReader` (and so ParaView) and meshio. Cell arrays
 //! `region` (Int32), `min_dihedral`, `max_dihedral` (Float64, degrees),
 //! `quality` (Float64, minimum sine of the signed dihedral angles, as in the
@@ -102,7 +103,7 @@ fn compressed_base64(raw: &[u8]) -> std::io::Result<String> {
     let mut compressed = Vec::new();
     let mut sizes = Vec::new();
     for chunk in raw.chunks(BLOCK) {
-        let mut z = flate2::write::ZlibEncoder::new(Vec::new(), flate2::Compression::default());
+        let mut z = flate2::write::ZlibEncoder::new(Vec::new(), flate2::Compression::fast());
         z.write_all(chunk)?;
         let c = z.finish()?;
         sizes.push(c.len() as u64);
