@@ -6,8 +6,12 @@
 //! the file and, where there is one, the line. Writers go through
 //! [`write_atomic`], so a failed write never leaves a partial file behind.
 
+pub mod gid;
+pub mod gmsh;
 pub mod medit;
+pub mod tetgen;
 mod text;
+pub mod vtk;
 
 pub use text::Tokens;
 
@@ -70,7 +74,7 @@ pub enum Format {
     Gid,
     /// VTK XML unstructured grid `.vtu`.
     Vtu,
-    /// TetGen `.node` / `.ele` / `.face`.
+    /// TetGen `.node` / `.ele` / `.face` / `.edge`.
     Tetgen,
 }
 
@@ -87,18 +91,24 @@ impl Format {
         match extension(path).as_str() {
             "mesh" => Ok(Format::Medit),
             "vtu" => Ok(Format::Vtu),
-            "node" | "ele" | "face" => Ok(Format::Tetgen),
+            "node" | "ele" | "face" | "edge" => Ok(Format::Tetgen),
             "msh" => {
-                let mut head = [0u8; 64];
-                let n = {
+                let mut head = Vec::with_capacity(4096);
+                {
                     use std::io::Read;
-                    let mut f =
-                        File::open(path).map_err(|e| IoError::file(path, open_message(&e)))?;
-                    f.read(&mut head)
-                        .map_err(|e| IoError::file(path, e.to_string()))?
-                };
-                let text = String::from_utf8_lossy(&head[..n]);
-                let first = text.split_whitespace().next().unwrap_or("");
+                    let f = File::open(path).map_err(|e| IoError::file(path, open_message(&e)))?;
+                    f.take(4096)
+                        .read_to_end(&mut head)
+                        .map_err(|e| IoError::file(path, e.to_string()))?;
+                }
+                // The first word outside GiD's `#` comment lines.
+                let text = String::from_utf8_lossy(&head);
+                let first = text
+                    .lines()
+                    .map(|l| l.split('#').next().unwrap_or(""))
+                    .flat_map(str::split_whitespace)
+                    .next()
+                    .unwrap_or("");
                 if first.eq_ignore_ascii_case("MESH") {
                     Ok(Format::Gid)
                 } else {
@@ -149,10 +159,10 @@ pub(crate) fn read_bytes(path: &Path) -> Result<Vec<u8>, IoError> {
 pub fn read_mesh(path: &Path) -> Result<MeshData, IoError> {
     match Format::for_reading(path)? {
         Format::Medit => medit::read(path),
-        other => Err(IoError::file(
-            path,
-            format!("reading {other:?} is not supported yet"),
-        )),
+        Format::Gmsh => gmsh::read(path),
+        Format::Gid => gid::read(path),
+        Format::Vtu => vtk::read(path),
+        Format::Tetgen => tetgen::read(path),
     }
 }
 
@@ -170,11 +180,61 @@ pub fn load_mesh(path: &Path) -> Result<(TetMesh, crate::mesh::BuildReport), IoE
 pub fn write_mesh(path: &Path, mesh: &TetMesh) -> Result<(), IoError> {
     match Format::for_writing(path)? {
         Format::Medit => medit::write(path, mesh),
-        other => Err(IoError::file(
-            path,
-            format!("writing {other:?} is not supported yet"),
-        )),
+        Format::Gmsh => gmsh::write(path, mesh),
+        Format::Vtu => vtk::write_vtu(path, mesh, &[]),
+        Format::Tetgen => tetgen::write(path, mesh),
+        Format::Gid => Err(IoError::file(path, "writing GiD is not supported")),
     }
+}
+
+/// Drops the points that no tet, marked triangle, tagged edge or vertex tag
+/// uses and renumbers the rest densely, in their old order (for files that
+/// carry the mid-side nodes of quadratic elements).
+pub(crate) fn drop_unused_points(d: &mut MeshData) {
+    let mut used = vec![false; d.points.len()];
+    let mark = |used: &mut Vec<bool>, v: u32| {
+        if let Some(u) = used.get_mut(v as usize) {
+            *u = true;
+        }
+    };
+    for t in &d.tets {
+        t.iter().for_each(|&v| mark(&mut used, v));
+    }
+    for (f, _) in &d.triangles {
+        f.iter().for_each(|&v| mark(&mut used, v));
+    }
+    for (e, _) in &d.edges {
+        e.iter().for_each(|&v| mark(&mut used, v));
+    }
+    for &v in d.corners.iter().chain(&d.required_vertices) {
+        mark(&mut used, v);
+    }
+    if used.iter().all(|&u| u) {
+        return;
+    }
+    let mut new_id = vec![u32::MAX; d.points.len()];
+    let mut points = Vec::with_capacity(used.iter().filter(|&&u| u).count());
+    for (i, p) in d.points.iter().enumerate() {
+        if used[i] {
+            new_id[i] = points.len() as u32;
+            points.push(*p);
+        }
+    }
+    let map = |v: &mut u32| {
+        if let Some(&n) = new_id.get(*v as usize) {
+            *v = n;
+        }
+    };
+    d.tets.iter_mut().for_each(|t| t.iter_mut().for_each(map));
+    d.triangles
+        .iter_mut()
+        .for_each(|(f, _)| f.iter_mut().for_each(map));
+    d.edges
+        .iter_mut()
+        .for_each(|(e, _)| e.iter_mut().for_each(map));
+    d.corners.iter_mut().for_each(map);
+    d.required_vertices.iter_mut().for_each(map);
+    d.points = points;
 }
 
 /// Writes through a temporary file beside `path` and renames it into place,

@@ -30,6 +30,7 @@ impl<'a> Tokens<'a> {
     }
 
     /// Line of the token returned last.
+    #[allow(clippy::misnamed_getters)] // `line` is where the cursor is; this is the token's
     pub fn line(&self) -> usize {
         self.last_line
     }
@@ -153,4 +154,95 @@ pub(crate) fn as_text<'a>(path: &Path, bytes: &'a [u8]) -> Result<&'a str, IoErr
             "not a text file (invalid UTF-8): expected an ASCII mesh",
         )
     })
+}
+
+/// The records of a line-oriented text file: each non-blank line, with `#`
+/// comments removed, split into whitespace-separated fields, with its 1-based
+/// line number. Used by the TetGen and GiD readers, whose records never span
+/// lines.
+pub(crate) struct Records<'a> {
+    path: &'a Path,
+    lines: std::iter::Enumerate<std::str::Lines<'a>>,
+    /// Line of the record returned last (or of the end of the file).
+    pub line: usize,
+    fields: Vec<&'a str>,
+}
+
+impl<'a> Records<'a> {
+    /// Records of `text`, read from `path`.
+    pub fn new(path: &'a Path, text: &'a str) -> Records<'a> {
+        Records {
+            path,
+            lines: text.lines().enumerate(),
+            line: 0,
+            fields: Vec::new(),
+        }
+    }
+
+    /// The next record, or `None` at the end of the file.
+    pub fn next_record(&mut self) -> Option<Vec<&'a str>> {
+        for (i, l) in self.lines.by_ref() {
+            self.line = i + 1;
+            let l = l.split('#').next().unwrap_or("");
+            self.fields.clear();
+            self.fields.extend(l.split_whitespace());
+            if !self.fields.is_empty() {
+                return Some(self.fields.clone());
+            }
+        }
+        self.line += 1;
+        None
+    }
+
+    /// The next record, which must exist and have at least `min` fields.
+    pub fn record(&mut self, what: &str, min: usize) -> Result<Vec<&'a str>, IoError> {
+        let path = self.path;
+        match self.next_record() {
+            None => Err(IoError::at(
+                path,
+                self.line,
+                format!("file ends where {what} was expected (truncated?)"),
+            )),
+            Some(f) if f.len() < min => Err(IoError::at(
+                path,
+                self.line,
+                format!("{what} needs at least {min} fields, found {}", f.len()),
+            )),
+            Some(_) => Ok(self.fields.clone()),
+        }
+    }
+
+    /// An error at the line of the record returned last.
+    pub fn error(&self, message: impl Into<String>) -> IoError {
+        IoError::at(self.path, self.line, message)
+    }
+
+    /// Field `s` parsed as `T`; `what` names it in the message.
+    pub fn parse<T: FromStr>(&self, s: &str, what: &str) -> Result<T, IoError> {
+        s.parse::<T>()
+            .map_err(|_| self.error(format!("expected {what}, found '{}'", shorten(s))))
+    }
+
+    /// Field `s` as a finite coordinate.
+    pub fn coord(&self, s: &str, what: &str) -> Result<f64, IoError> {
+        let x: f64 = self.parse(s, what)?;
+        if !x.is_finite() {
+            return Err(self.error(format!("{what} is {x}, not a finite number")));
+        }
+        Ok(x)
+    }
+
+    /// Field `s` as a non-negative count no larger than `max`.
+    pub fn count(&self, s: &str, what: &str, max: usize) -> Result<usize, IoError> {
+        let n: i64 = self.parse(s, what)?;
+        if n < 0 {
+            return Err(self.error(format!("{what} {n} is negative")));
+        }
+        if n as u64 > max as u64 {
+            return Err(self.error(format!(
+                "{what} {n} is more than the file can hold (corrupt or truncated)"
+            )));
+        }
+        Ok(n as usize)
+    }
 }
