@@ -157,7 +157,7 @@ pub fn tet_min_sine(p: &[DVec3; 4]) -> f64 {
         n[2].length_squared(),
         n[3].length_squared(),
     ];
-    if n2.iter().any(|&x| x == 0.0) {
+    if n2.contains(&0.0) {
         return 0.0;
     }
     let inv = [1.0 / n2[0], 1.0 / n2[1], 1.0 / n2[2], 1.0 / n2[3]];

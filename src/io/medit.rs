@@ -55,7 +55,9 @@ pub fn read(path: &Path) -> Result<MeshData, IoError> {
             }
             "Vertices" => {
                 let n = count(&mut tok, "vertex count")?;
-                data.points.reserve(n);
+                // A count larger than the file could hold is caught as a
+                // truncation below; do not let it reserve memory first.
+                data.points.reserve(n.min(text.len() / 8));
                 for _ in 0..n {
                     let x = tok.coord("an x coordinate")?;
                     let y = tok.coord("a y coordinate")?;
@@ -69,9 +71,10 @@ pub fn read(path: &Path) -> Result<MeshData, IoError> {
                 need_vertices(&tok, saw_vertices, "Tetrahedra")?;
                 let n = count(&mut tok, "tetrahedron count")?;
                 let np = data.points.len();
-                data.tets.reserve(n);
-                data.tet_regions.reserve(n);
-                data.tet_lines.reserve(n);
+                let cap = n.min(text.len() / 10);
+                data.tets.reserve(cap);
+                data.tet_regions.reserve(cap);
+                data.tet_lines.reserve(cap);
                 for _ in 0..n {
                     let a = tok.index1("vertex index", np)?;
                     let line = tok.line() as u32;

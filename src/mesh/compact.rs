@@ -72,8 +72,8 @@ impl TetMesh {
         self.free.clear();
 
         let mut pw = 0;
-        for p in 0..self.points.len() {
-            if used[p] {
+        for (p, &u) in used.iter().enumerate() {
+            if u {
                 self.points[pw] = self.points[p];
                 pw += 1;
             }

@@ -166,7 +166,7 @@ impl TetMesh {
     }
 
     /// Moves point `v`. The caller is responsible for orientation (see
-    /// [`TetMesh::tets_stay_positive`]).
+    /// [`crate::smooth::ball_stays_positive`]).
     #[inline]
     pub fn set_point(&mut self, v: u32, p: DVec3) {
         self.points[v as usize] = p;
@@ -563,9 +563,9 @@ impl TetMesh {
             let t = out[i];
             i += 1;
             let tv = self.tets[t as usize];
-            for f in 0..4 {
+            for (f, &opposite) in tv.iter().enumerate() {
                 // Only faces that contain v lead to other tets of the ball.
-                if tv[f] == v {
+                if opposite == v {
                     continue;
                 }
                 let h = self.adj[t as usize][f];

@@ -421,11 +421,11 @@ pub fn catmull_clark_weighted(
         let nv = cur.points.len();
         let ne = h.edges.len();
         let mut next_origin = vec![Origin::Vertex; nv];
-        next_origin.extend(std::iter::repeat(Origin::Edge).take(ne));
-        next_origin.extend(std::iter::repeat(Origin::Face).take(cur.faces.len()));
+        next_origin.extend(std::iter::repeat_n(Origin::Edge, ne));
+        next_origin.extend(std::iter::repeat_n(Origin::Face, cur.faces.len()));
         let mut next_group = Vec::with_capacity(faces.len());
         for (f, face) in cur.faces.iter().enumerate() {
-            next_group.extend(std::iter::repeat(face_group[f]).take(face.len()));
+            next_group.extend(std::iter::repeat_n(face_group[f], face.len()));
         }
         let mut next_locked = HashMap::new();
         for (e, pair) in h.edges.iter().enumerate() {

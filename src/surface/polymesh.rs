@@ -192,7 +192,7 @@ impl HalfEdges {
         let mut face = Vec::with_capacity(nh);
         for (fi, f) in mesh.faces.iter().enumerate() {
             origin.extend_from_slice(f);
-            face.extend(std::iter::repeat(fi as u32).take(f.len()));
+            face.extend(std::iter::repeat_n(fi as u32, f.len()));
         }
         let dest = |h: usize| -> u32 {
             let f = face[h] as usize;
