@@ -1,5 +1,9 @@
 //! Reports: statistics, histograms and JSON.
 
+pub mod histogram;
 pub mod stats;
+pub mod table;
 
+pub use histogram::write_histogram;
 pub use stats::{Histogram, MeshStats};
+pub use table::format_table;
