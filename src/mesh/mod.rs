@@ -18,6 +18,7 @@ mod build;
 mod check;
 mod compact;
 mod data;
+pub mod generate;
 
 pub use build::{BuildReport, MeshError};
 pub use check::CheckError;

@@ -3,11 +3,13 @@
 //! the minimum-dihedral histogram. Computed in parallel in one sweep over the
 //! tets; edges are counted without a global edge table (see [`edge_owner_mask`]).
 
-use crate::geom::{orient3d, tet_quality, TET_EDGES};
-use crate::mesh::{TetMesh, NO_ADJ};
+use crate::geom::{orient3d, TET_EDGES, TET_EDGE_OPPOSITE};
+use crate::mesh::{TetMesh, DEAD, NO_ADJ};
+use glam::DVec3;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
+use std::sync::atomic::{AtomicU32, Ordering};
 
 /// Worst / average / best of the per-tet minimum dihedral angle, in degrees.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -65,11 +67,12 @@ impl Histogram {
         let n = self.counts.len();
         let lo = self.edges_deg[0];
         let hi = self.edges_deg[n];
-        let b = ((x - lo) / (hi - lo) * n as f64).floor();
-        if b.is_nan() || b < 0.0 {
-            0
+        let y = (x - lo) / (hi - lo) * n as f64;
+        // Truncation is the floor for y >= 0; below 0 and NaN go to bin 0.
+        if y >= 0.0 {
+            (y as usize).min(n - 1)
         } else {
-            (b as usize).min(n - 1)
+            0
         }
     }
 }
@@ -113,22 +116,353 @@ pub struct MeshStats {
 /// at the first smaller id, which keeps the average cost near half a ring.
 #[inline]
 pub fn edge_owner_mask(mesh: &TetMesh, t: u32) -> u8 {
+    owner_mask(&mesh.tets, &mesh.adj, t)
+}
+
+/// [`edge_owner_mask`] on the raw arrays, one edge after the other.
+#[inline]
+fn owner_mask(tets: &[[u32; 4]], adj: &[[u32; 4]], t: u32) -> u8 {
     let mut mask = 0u8;
+    let candidates = owner_candidates(adj, t);
     for e in 0..6 {
-        let mut owner = true;
-        mesh.for_each_tet_around_edge(t, e, |u| {
-            if u < t {
-                owner = false;
-            }
-            owner
-        });
-        if owner {
-            mask |= 1 << e;
+        if candidates & (1 << e) != 0 {
+            let mut w = EdgeWalk::new(tets, adj, t, e);
+            let owned = loop {
+                if let Some(owned) = w.step(tets, adj) {
+                    break owned;
+                }
+            };
+            mask |= (owned as u8) << e;
         }
     }
     mask
 }
 
+/// The local edges of `t` that it may own: those whose two faces in `t` both
+/// lead to a larger id (or to the boundary). The neighbours across those faces
+/// are the first tets of the ring in either direction and come with `adj[t]`,
+/// so most edges that `t` does not own are settled here without a walk.
+#[inline(always)]
+fn owner_candidates(adj: &[[u32; 4]], t: u32) -> u8 {
+    // Neighbour ids, the boundary counting as larger than everything.
+    let nb = adj[t as usize].map(|h| if h == NO_ADJ { u32::MAX } else { h >> 2 });
+    let mut mask = 0u8;
+    for (e, &[k, l]) in TET_EDGE_OPPOSITE.iter().enumerate() {
+        mask |= ((nb[k] > t && nb[l] > t) as u8) << e;
+    }
+    mask
+}
+
+/// The smallest live tet id incident to each vertex (`u32::MAX` for unused
+/// points), in parallel; the minimum does not depend on the order.
+///
+/// Every tet around edge `ab` holds both `a` and `b`, so none is smaller than
+/// `max(first[a], first[b])`: a tet with exactly that id owns the edge without
+/// a walk. That settles about half of the owned edges.
+fn first_tets(tets: &[[u32; 4]], n_points: usize) -> Vec<u32> {
+    let first: Vec<AtomicU32> = (0..n_points).map(|_| AtomicU32::new(u32::MAX)).collect();
+    (0..tets.len().div_ceil(CHUNK))
+        .into_par_iter()
+        .for_each(|c| {
+            let lo = c * CHUNK;
+            let hi = (lo + CHUNK).min(tets.len());
+            for (t, v) in tets[lo..hi].iter().enumerate() {
+                if v[0] == DEAD {
+                    continue;
+                }
+                let t = (lo + t) as u32;
+                for &x in v {
+                    let f = &first[x as usize];
+                    let mut cur = f.load(Ordering::Relaxed);
+                    // Ascending t within a chunk: after the first visit this is
+                    // one load and a comparison.
+                    while t < cur {
+                        match f.compare_exchange_weak(cur, t, Ordering::Relaxed, Ordering::Relaxed)
+                        {
+                            Ok(_) => break,
+                            Err(now) => cur = now,
+                        }
+                    }
+                }
+            }
+        });
+    first.into_iter().map(AtomicU32::into_inner).collect()
+}
+
+/// One walk around local edge `e` of tet `t`, looking for a smaller id: the
+/// walk of [`TetMesh::for_each_tet_around_edge`] (first one way from `t`, and
+/// the other way if it reaches the boundary), as a resumable state so that
+/// many walks can be interleaved and their memory accesses overlap.
+#[derive(Clone, Copy)]
+struct EdgeWalk {
+    t: u32,
+    va: u32,
+    vb: u32,
+    /// Adjacency row of the current tet, loaded together with its vertices so
+    /// that the two loads of a step overlap.
+    row: [u32; 4],
+    exit: u8,
+    e: u8,
+    second_pass: bool,
+}
+
+impl EdgeWalk {
+    #[inline(always)]
+    fn new(tets: &[[u32; 4]], adj: &[[u32; 4]], t: u32, e: usize) -> EdgeWalk {
+        let v = tets[t as usize];
+        EdgeWalk {
+            t,
+            va: v[TET_EDGES[e][0]],
+            vb: v[TET_EDGES[e][1]],
+            row: adj[t as usize],
+            exit: TET_EDGE_OPPOSITE[e][0] as u8,
+            e: e as u8,
+            second_pass: false,
+        }
+    }
+
+    /// Crosses one face. `Some(true)`: no smaller id around the edge (`t` owns
+    /// it); `Some(false)`: a smaller id was found; `None`: not finished.
+    #[inline(always)]
+    fn step(&mut self, tets: &[[u32; 4]], adj: &[[u32; 4]]) -> Option<bool> {
+        let h = self.row[self.exit as usize];
+        if h == NO_ADJ {
+            if self.second_pass {
+                return Some(true);
+            }
+            // Boundary: walk the other way from t.
+            self.second_pass = true;
+            self.row = adj[self.t as usize];
+            self.exit = TET_EDGE_OPPOSITE[self.e as usize][1] as u8;
+            return None;
+        }
+        let nt = h >> 2;
+        if nt == self.t {
+            return Some(true); // closed ring, every tet seen
+        }
+        if nt < self.t {
+            return Some(false);
+        }
+        let nv = tets[nt as usize];
+        self.row = adj[nt as usize];
+        // Leave nt through the face opposite its vertex that is neither an end
+        // of the edge nor opposite the face we came in by.
+        let mut used = 1u32 << (h & 3);
+        for (i, &x) in nv.iter().enumerate() {
+            used |= ((x == self.va) as u32 | (x == self.vb) as u32) << i;
+        }
+        debug_assert_eq!(used.count_ones(), 3, "edge ring broken");
+        self.exit = (!used & 0xF).trailing_zeros() as u8;
+        None
+    }
+}
+
+/// Walks in flight at once in [`resolve_owners`].
+const WALKS_IN_FLIGHT: usize = 16;
+
+/// Settles the candidate edges `(t, e)` (ascending `t` from `first`) and sets
+/// bit `e` of `masks[t - first]` for each owned one. Up to
+/// [`WALKS_IN_FLIGHT`] walks advance in turn, one face each, so that their
+/// cache misses overlap instead of following one another.
+fn resolve_owners(
+    tets: &[[u32; 4]],
+    adj: &[[u32; 4]],
+    candidates: &[(u32, u8)],
+    first: usize,
+    masks: &mut [u8],
+) {
+    let mut pool = [EdgeWalk {
+        t: 0,
+        va: 0,
+        vb: 0,
+        row: [NO_ADJ; 4],
+        exit: 0,
+        e: 0,
+        second_pass: false,
+    }; WALKS_IN_FLIGHT];
+    let mut next = 0;
+    let mut live = 0;
+    while live < WALKS_IN_FLIGHT && next < candidates.len() {
+        let (t, e) = candidates[next];
+        pool[live] = EdgeWalk::new(tets, adj, t, e as usize);
+        live += 1;
+        next += 1;
+    }
+    while live > 0 {
+        let mut i = 0;
+        while i < live {
+            match pool[i].step(tets, adj) {
+                None => i += 1,
+                Some(owned) => {
+                    let w = pool[i];
+                    masks[w.t as usize - first] |= (owned as u8) << w.e;
+                    if next < candidates.len() {
+                        let (t, e) = candidates[next];
+                        pool[i] = EdgeWalk::new(tets, adj, t, e as usize);
+                        next += 1;
+                        i += 1;
+                    } else {
+                        live -= 1;
+                        pool[i] = pool[live];
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// Tets whose angles are computed side by side (see [`angle_extremes`]).
+const LANES: usize = 4;
+
+/// One `f64` per tet of a batch.
+type Lanes = [f64; LANES];
+
+/// A point or vector per tet of a batch, coordinate-major so that the
+/// compiler can use vector instructions across the batch.
+#[derive(Clone, Copy)]
+struct LaneVec {
+    x: Lanes,
+    y: Lanes,
+    z: Lanes,
+}
+
+#[inline(always)]
+fn lanes(f: impl Fn(usize) -> f64) -> Lanes {
+    [f(0), f(1), f(2), f(3)]
+}
+
+impl LaneVec {
+    #[inline(always)]
+    fn sub(self, o: LaneVec) -> LaneVec {
+        LaneVec {
+            x: lanes(|i| self.x[i] - o.x[i]),
+            y: lanes(|i| self.y[i] - o.y[i]),
+            z: lanes(|i| self.z[i] - o.z[i]),
+        }
+    }
+
+    /// glam's `DVec3::cross`, operation for operation.
+    #[inline(always)]
+    fn cross(self, o: LaneVec) -> LaneVec {
+        LaneVec {
+            x: lanes(|i| self.y[i] * o.z[i] - o.y[i] * self.z[i]),
+            y: lanes(|i| self.z[i] * o.x[i] - o.z[i] * self.x[i]),
+            z: lanes(|i| self.x[i] * o.y[i] - o.x[i] * self.y[i]),
+        }
+    }
+
+    /// glam's `DVec3::dot`, operation for operation.
+    #[inline(always)]
+    fn dot(self, o: LaneVec) -> Lanes {
+        lanes(|i| (self.x[i] * o.x[i]) + (self.y[i] * o.y[i]) + (self.z[i] * o.z[i]))
+    }
+}
+
+/// Smallest and largest dihedral angle (degrees), `D` = six times the signed
+/// volume, and `|a|²|b|²|c|²` for the edge vectors `a, b, c` from corner 0 (see
+/// [`is_inverted`]) of each tet of a batch (corner `j` of tet `i` in lane `i`
+/// of `p[j]`).
+///
+/// The arithmetic is that of [`crate::geom::tet_quality`], operation for
+/// operation and in the same order, so the results are the same bits; only the
+/// sines, which the statistics do not need, are left out, and the tets of the
+/// batch go side by side through the vector units.
+#[inline(always)]
+fn angle_extremes(p: &[LaneVec; 4]) -> (Lanes, Lanes, Lanes, Lanes) {
+    let e1 = p[1].sub(p[0]);
+    let e2 = p[2].sub(p[0]);
+    let e3 = p[3].sub(p[0]);
+    let n = [
+        p[2].sub(p[1]).cross(p[3].sub(p[1])),
+        e3.cross(e2),
+        e1.cross(e3),
+        e2.cross(e1),
+    ];
+    // DVec3::length_recip = 1 / sqrt(dot(v, v)).
+    let inv = n.map(|v| {
+        let l2 = v.dot(v);
+        lanes(|i| 1.0 / l2[i].sqrt())
+    });
+    let d = e1.dot(e2.cross(e3));
+    let (l1, l2, l3) = (e1.dot(e1), e2.dot(e2), e3.dot(e3));
+    let edge_product = lanes(|i| l1[i] * l2[i] * l3[i]);
+    let mut max_cos = [f64::NEG_INFINITY; LANES];
+    let mut min_cos = [f64::INFINITY; LANES];
+    for &[k, l] in &TET_EDGE_OPPOSITE {
+        let dot = n[k].dot(n[l]);
+        for i in 0..LANES {
+            let s = inv[k][i] * inv[l][i];
+            let cos = -dot[i] * s;
+            max_cos[i] = max_cos[i].max(cos);
+            min_cos[i] = min_cos[i].min(cos);
+        }
+    }
+    let mut lo = [0.0; LANES];
+    let mut hi = [0.0; LANES];
+    for i in 0..LANES {
+        if !(0..4).all(|f| inv[f][i].is_finite()) {
+            // A face of zero area: the convention of tet_quality.
+            (lo[i], hi[i]) = (0.0, 180.0);
+            continue;
+        }
+        lo[i] = max_cos[i].clamp(-1.0, 1.0).acos().to_degrees();
+        hi[i] = min_cos[i].clamp(-1.0, 1.0).acos().to_degrees();
+        if d[i] < 0.0 {
+            (lo[i], hi[i]) = (-hi[i], -lo[i]);
+        }
+    }
+    (lo, hi, d, edge_product)
+}
+
+/// Whether a tet with float determinant `d` and squared edge-vector lengths
+/// product `edge_product` (from [`angle_extremes`]) is inverted or flat by the
+/// exact predicate; `corners` gives its points when that must be evaluated.
+///
+/// The float determinant `a·(b×c)` of the edge vectors from corner 0 is off by
+/// at most about 10ε times its permanent Σ|a_i b_j c_k| ≤ 3√3 |a||b||c| (the
+/// bound of Shewchuk's orient3d filter), i.e. below 6e-15·|a||b||c|. When
+/// `d² > 1e-26·|a|²|b|²|c|²` (a margin of 15) its sign is therefore exact;
+/// otherwise, and when the product under- or overflows, the exact predicate
+/// decides.
+#[inline(always)]
+fn is_inverted(d: f64, edge_product: f64, corners: impl FnOnce() -> [DVec3; 4]) -> bool {
+    if edge_product > 1e-250 && edge_product.is_finite() && d * d > 1e-26 * edge_product {
+        d < 0.0
+    } else {
+        let p = corners();
+        orient3d(p[0], p[1], p[2], p[3]) <= 0.0
+    }
+}
+
+/// Tets per region, for one chunk: few distinct ids, so a short list with the
+/// last hit first beats a map.
+#[derive(Clone, Default)]
+struct RegionCounts(Vec<(i32, usize)>);
+
+impl RegionCounts {
+    #[inline]
+    fn add(&mut self, r: i32) {
+        if let Some(first) = self.0.first_mut() {
+            if first.0 == r {
+                first.1 += 1;
+                return;
+            }
+        }
+        match self.0.iter().position(|x| x.0 == r) {
+            Some(i) => {
+                self.0[i].1 += 1;
+                self.0.swap(0, i);
+            }
+            None => {
+                self.0.push((r, 1));
+                let last = self.0.len() - 1;
+                self.0.swap(0, last);
+            }
+        }
+    }
+}
+
+/// Partial sums of one chunk of tet slots.
 #[derive(Clone)]
 struct Acc {
     min_worst: f64,
@@ -142,6 +476,7 @@ struct Acc {
     edges: usize,
     tets: usize,
     hist: Vec<u64>,
+    regions: RegionCounts,
 }
 
 impl Acc {
@@ -158,6 +493,42 @@ impl Acc {
             edges: 0,
             tets: 0,
             hist: vec![0; bins],
+            regions: RegionCounts::default(),
+        }
+    }
+
+    /// Adds the angles, volume and inversion of up to [`LANES`] live tets, in
+    /// the order given (so that the sums do not depend on the batching).
+    #[inline(always)]
+    fn add_tets(
+        &mut self,
+        tets: &[[u32; 4]],
+        points: &[DVec3],
+        batch: &[usize],
+        histogram: &Histogram,
+    ) {
+        let corner = |j: usize| {
+            let q = |i: usize| points[tets[batch[i.min(batch.len() - 1)]][j] as usize];
+            LaneVec {
+                x: lanes(|i| q(i).x),
+                y: lanes(|i| q(i).y),
+                z: lanes(|i| q(i).z),
+            }
+        };
+        let p = [corner(0), corner(1), corner(2), corner(3)];
+        let (lo, hi, d, edge_product) = angle_extremes(&p);
+        for (i, &t) in batch.iter().enumerate() {
+            self.tets += 1;
+            self.min_worst = self.min_worst.min(lo[i]);
+            self.min_best = self.min_best.max(lo[i]);
+            self.min_sum += lo[i];
+            self.max_worst = self.max_worst.max(hi[i]);
+            self.max_sum += hi[i];
+            self.volume += d[i] / 6.0;
+            self.inverted += is_inverted(d[i], edge_product[i], || {
+                tets[t].map(|k| points[k as usize])
+            }) as usize;
+            self.hist[histogram.bin(lo[i])] += 1;
         }
     }
 
@@ -175,9 +546,14 @@ impl Acc {
         for (a, b) in self.hist.iter_mut().zip(o.hist) {
             *a += b;
         }
+        self.regions.0.extend(o.regions.0);
         self
     }
 }
+
+/// Tet slots per parallel task. Fixed, so that the floating-point sums are
+/// grouped the same way whatever the number of threads.
+const CHUNK: usize = 8192;
 
 impl MeshStats {
     /// Statistics with the default histogram (1° bins over 0–71°).
@@ -190,14 +566,18 @@ impl MeshStats {
 
     /// Statistics, filling the given (empty) histogram bins.
     ///
-    /// Sums are accumulated in fixed-size chunks merged in order, so the result
-    /// does not depend on the number of threads.
+    /// One parallel sweep over fixed-size chunks of tet slots computes the
+    /// angles, volume, inversion, boundary faces, histogram, regions and which
+    /// edges each tet owns ([`edge_owner_mask`]); the chunk sums are merged in
+    /// chunk order, so the result does not depend on the number of threads.
+    /// A second, sequential pass adds the owned edges to the vertex valences.
     pub fn compute_with(mesh: &TetMesh, mut histogram: Histogram) -> MeshStats {
         let bins = histogram.counts.len();
         let slots = mesh.n_tet_slots();
-        const CHUNK: usize = 8192;
-        let tets = mesh.tet_slots();
+        let (tets, adj, points) = (&mesh.tets[..], &mesh.adj[..], &mesh.points[..]);
         let hist_ref = &histogram;
+        let first = first_tets(tets, points.len());
+        let first = &first[..];
         let (acc, masks): (Vec<Acc>, Vec<Vec<u8>>) = (0..slots.div_ceil(CHUNK))
             .into_par_iter()
             .map(|c| {
@@ -205,33 +585,39 @@ impl MeshStats {
                 let lo = c * CHUNK;
                 let hi = (lo + CHUNK).min(slots);
                 let mut masks = vec![0u8; hi - lo];
+                let mut candidates: Vec<(u32, u8)> = Vec::with_capacity(3 * (hi - lo));
+                let mut batch = [0usize; LANES];
+                let mut in_batch = 0;
                 for t in lo..hi {
-                    if tets[t][0] == crate::mesh::DEAD {
+                    if tets[t][0] == DEAD {
                         continue;
                     }
-                    let t32 = t as u32;
-                    let p = mesh.tet_points(t32);
-                    let q = tet_quality(&p);
-                    a.tets += 1;
-                    a.min_worst = a.min_worst.min(q.min_dihedral_deg);
-                    a.min_best = a.min_best.max(q.min_dihedral_deg);
-                    a.min_sum += q.min_dihedral_deg;
-                    a.max_worst = a.max_worst.max(q.max_dihedral_deg);
-                    a.max_sum += q.max_dihedral_deg;
-                    a.volume += q.volume;
-                    // The float volume decides nearly always; the exact predicate
-                    // settles the near-flat cases.
-                    if q.volume <= 1e-12 * (p[1] - p[0]).length_squared().powf(1.5)
-                        && orient3d(p[0], p[1], p[2], p[3]) <= 0.0
-                    {
-                        a.inverted += 1;
+                    a.boundary += adj[t].iter().filter(|&&h| h == NO_ADJ).count();
+                    a.regions.add(mesh.region[t]);
+                    let c = owner_candidates(adj, t as u32);
+                    let v = tets[t];
+                    for (e, &[i, j]) in TET_EDGES.iter().enumerate() {
+                        if c & (1 << e) != 0 {
+                            let f = first[v[i] as usize].max(first[v[j] as usize]);
+                            if f == t as u32 {
+                                masks[t - lo] |= 1 << e;
+                            } else {
+                                candidates.push((t as u32, e as u8));
+                            }
+                        }
                     }
-                    a.hist[hist_ref.bin(q.min_dihedral_deg)] += 1;
-                    a.boundary += mesh.adj(t32).iter().filter(|&&h| h == NO_ADJ).count();
-                    let m = edge_owner_mask(mesh, t32);
-                    a.edges += m.count_ones() as usize;
-                    masks[t - lo] = m;
+                    batch[in_batch] = t;
+                    in_batch += 1;
+                    if in_batch == LANES {
+                        a.add_tets(tets, points, &batch, hist_ref);
+                        in_batch = 0;
+                    }
                 }
+                if in_batch > 0 {
+                    a.add_tets(tets, points, &batch[..in_batch], hist_ref);
+                }
+                resolve_owners(tets, adj, &candidates, lo, &mut masks);
+                a.edges = masks.iter().map(|m| m.count_ones() as usize).sum();
                 (a, masks)
             })
             .unzip();
@@ -260,10 +646,10 @@ impl MeshStats {
         let vmax = valence.iter().copied().max().unwrap_or(0);
 
         let mut regions: BTreeMap<i32, usize> = BTreeMap::new();
-        for t in mesh.tet_ids() {
-            *regions.entry(mesh.region(t)).or_default() += 1;
+        for (r, n) in acc.regions.0 {
+            *regions.entry(r).or_default() += n;
         }
-        histogram.counts = acc.hist.clone();
+        histogram.counts = acc.hist;
         let n = acc.tets.max(1) as f64;
         MeshStats {
             nodes,
