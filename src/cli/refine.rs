@@ -8,6 +8,12 @@ use tetrefine::refine::{locate_parents, refine_step_with_progress, BoundaryRule,
 use tetrefine::report::steps::{step_row, step_table_header, StepStats};
 use tetrefine::MeshStats;
 
+/// The `--stats` file: `{"steps": [input, step 1, …]}`.
+#[derive(serde::Serialize)]
+struct StatsFile<'a> {
+    steps: &'a [StepStats],
+}
+
 /// Arguments of `refine`.
 #[derive(clap::Args)]
 pub struct Args {
@@ -79,12 +85,11 @@ pub fn run(a: Args) -> super::CliResult {
     }
     locate_parents(&input, &mut mesh);
     if let Some(path) = &a.stats {
-        let json = serde_json::json!({ "steps": steps });
-        let text = serde_json::to_string_pretty(&json).map_err(|e| e.to_string())?;
+        let text = serde_json::to_string_pretty(&StatsFile { steps: &steps }).map_err(|e| e.to_string())?;
         tetrefine::io::write_atomic(path, |w| std::io::Write::write_all(w, text.as_bytes()))
             .map_err(|e| e.to_string())?;
     }
-    super::write_refined(&a.output, &mesh)?;
+    super::write_refined(&a.output, &mut mesh, Vec::new())?;
     if let Some(h) = &a.histogram {
         let last = &steps.last().expect("input entry").stats;
         super::write_histogram(h, last)?;
