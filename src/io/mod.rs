@@ -7,6 +7,10 @@
 //! [`write_atomic`], so a failed write never leaves a partial file behind.
 
 pub mod medit;
+pub mod off;
+pub mod plc;
+pub mod poly;
+pub mod stl;
 mod text;
 
 pub use text::Tokens;
