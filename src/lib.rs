@@ -10,6 +10,8 @@ pub mod io;
 pub mod mesh;
 pub mod report;
 pub mod surface;
+#[cfg(feature = "tetgen")]
+pub mod tetgen;
 
 pub use mesh::{MeshData, TetMesh};
 pub use report::MeshStats;

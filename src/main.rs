@@ -19,6 +19,8 @@ enum Command {
     Quality(cli::quality::Args),
     /// Convert a mesh between formats, keeping regions, markers and features.
     Convert(cli::convert::Args),
+    /// Mesh the volume a closed surface encloses, with TetGen (opt-in feature `tetgen`).
+    Mesh(cli::mesh::Args),
 }
 
 fn main() -> ExitCode {
@@ -26,6 +28,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Quality(a) => cli::quality::run(a),
         Command::Convert(a) => cli::convert::run(a),
+        Command::Mesh(a) => cli::mesh::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

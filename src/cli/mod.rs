@@ -2,6 +2,7 @@
 //! user; `main` prints it on one line and exits non-zero.
 
 pub mod convert;
+pub mod mesh;
 pub mod quality;
 
 /// A one-line error for the user.

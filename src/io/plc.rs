@@ -146,6 +146,16 @@ pub enum PlcError {
         /// Second end point.
         b: u64,
     },
+    /// An edge or a point of one facet pierces another facet.
+    #[error("the surface intersects itself: facets {facet} and {other} intersect ({detail})")]
+    Intersect {
+        /// 1-based number of the piercing facet.
+        facet: usize,
+        /// 1-based number of the pierced facet.
+        other: usize,
+        /// How.
+        detail: String,
+    },
     /// Two facets leave an edge in the same direction: they overlap.
     #[error("facets {facet} and {other} overlap along edge ({a}, {b})")]
     Overlap {
@@ -543,6 +553,7 @@ impl Analysis {
         let hole_loops = a.facet_holes(plc)?;
         a.build_pieces(&hole_loops)?;
         let incidences = a.edge_incidences(&segments, &hole_loops)?;
+        a.check_intersections(&incidences)?;
         let mut sides = UnionFind::new(2 * a.pieces.len());
         a.glue_sides(&incidences, &mut sides)?;
         a.cells(plc, &mut sides, diag)
@@ -1008,6 +1019,122 @@ impl Analysis {
         }
         list.retain(|(_, incs)| !incs.is_empty());
         Ok(list)
+    }
+
+    /// Whether the 3-D point `q` (in the plane of piece `k`) lies strictly
+    /// inside the piece, farther than the tolerance from its boundary.
+    fn strictly_inside(&self, k: usize, q: DVec3) -> bool {
+        let g = &self.facets[self.pieces[k].facet];
+        let q = project(q, g.drop);
+        let loops = self.piece_loops(k);
+        loops.iter().all(|l| loop_distance(l, q) > self.tol)
+            && loops.iter().filter(|l| inside_loop(l, q)).count() % 2 == 1
+    }
+
+    /// Finds an edge of one facet that pierces another facet's interior, or
+    /// ends inside it (TetGen reports such input as self-intersecting).
+    /// Candidate pairs come from a uniform grid over the pieces' boxes.
+    /// Facets that overlap within one plane are found by `glue_sides` only
+    /// where they share an edge.
+    fn check_intersections(&self, edges: &[([u32; 2], Vec<Incidence>)]) -> Result<(), PlcError> {
+        let np = self.pieces.len();
+        let lo = self.pieces.iter().fold(DVec3::INFINITY, |a, p| a.min(p.lo));
+        let hi = self.pieces.iter().fold(DVec3::NEG_INFINITY, |a, p| a.max(p.hi));
+        let ext = (hi - lo).max(DVec3::splat(self.tol));
+        let h = (ext.x * ext.y * ext.z / np as f64).cbrt() * 1.5;
+        let dims: [usize; 3] = [0, 1, 2].map(|a| ((ext[a] / h).ceil() as usize).clamp(1, 64));
+        let cell = |x: DVec3| -> [usize; 3] {
+            [0, 1, 2].map(|a| {
+                (((x[a] - lo[a]) / ext[a] * dims[a] as f64).floor().max(0.0) as usize)
+                    .min(dims[a] - 1)
+            })
+        };
+        let grow = DVec3::splat(self.tol);
+        let mut grid: Vec<Vec<u32>> = vec![Vec::new(); dims[0] * dims[1] * dims[2]];
+        for (k, p) in self.pieces.iter().enumerate() {
+            let (c0, c1) = (cell(p.lo - grow), cell(p.hi + grow));
+            for i in c0[0]..=c1[0] {
+                for j in c0[1]..=c1[1] {
+                    for l in c0[2]..=c1[2] {
+                        grid[(i * dims[1] + j) * dims[2] + l].push(k as u32);
+                    }
+                }
+            }
+        }
+        let piece_verts: Vec<Vec<u32>> = (0..np)
+            .map(|k| {
+                let p = &self.pieces[k];
+                let g = &self.facets[p.facet];
+                let mut v: Vec<u32> = std::iter::once(p.outer)
+                    .chain(p.inner.iter().copied())
+                    .flat_map(|l| g.loops[l].verts.iter().copied())
+                    .collect();
+                v.sort_unstable();
+                v
+            })
+            .collect();
+        let mut stamp = vec![usize::MAX; np];
+        for (ei, (e, incs)) in edges.iter().enumerate() {
+            let (a, b) = (self.point(e[0]), self.point(e[1]));
+            let (elo, ehi) = (a.min(b) - grow, a.max(b) + grow);
+            let (c0, c1) = (cell(elo), cell(ehi));
+            let own = self.pieces[incs[0].piece as usize].facet;
+            for i in c0[0]..=c1[0] {
+                for j in c0[1]..=c1[1] {
+                    for l in c0[2]..=c1[2] {
+                        for &k in &grid[(i * dims[1] + j) * dims[2] + l] {
+                            let k = k as usize;
+                            if stamp[k] == ei {
+                                continue;
+                            }
+                            stamp[k] = ei;
+                            let p = &self.pieces[k];
+                            if piece_verts[k].binary_search(&e[0]).is_ok()
+                                || piece_verts[k].binary_search(&e[1]).is_ok()
+                                || ehi.cmplt(p.lo).any()
+                                || elo.cmpgt(p.hi).any()
+                            {
+                                continue;
+                            }
+                            let g = &self.facets[p.facet];
+                            let tolp = self.tol + g.deviation;
+                            let (da, db) = (g.n.dot(a - g.o), g.n.dot(b - g.o));
+                            let on_a = da.abs() <= tolp;
+                            let on_b = db.abs() <= tolp;
+                            let hit = if on_a && on_b {
+                                None // in the plane: not tested here
+                            } else if on_a || on_b {
+                                let (v, q) = if on_a { (e[0], a) } else { (e[1], b) };
+                                self.strictly_inside(k, q).then(|| {
+                                    format!("point {} of facet {} lies inside facet {}", v + 1, own + 1, p.facet + 1)
+                                })
+                            } else if (da > 0.0) != (db > 0.0) {
+                                let q = a + (b - a) * (da / (da - db));
+                                self.strictly_inside(k, q).then(|| {
+                                    format!(
+                                        "edge ({}, {}) of facet {} crosses facet {}",
+                                        e[0] + 1,
+                                        e[1] + 1,
+                                        own + 1,
+                                        p.facet + 1
+                                    )
+                                })
+                            } else {
+                                None
+                            };
+                            if let Some(detail) = hit {
+                                return Err(PlcError::Intersect {
+                                    facet: own + 1,
+                                    other: p.facet + 1,
+                                    detail,
+                                });
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        Ok(())
     }
 
     /// Sorts the pieces around each edge by angle and glues the sides that
@@ -1532,6 +1659,19 @@ mod tests {
         let mut p = unit_cube();
         p.points[7] = [1.0, 1.0, 1.3];
         assert!(matches!(p.validate(), Err(PlcError::BadFacet { .. })));
+    }
+
+    #[test]
+    fn interpenetrating_boxes_are_rejected() {
+        let mut p = unit_cube();
+        add_box(&mut p, [0.5; 3], [1.5; 3]);
+        let e = p.validate().unwrap_err();
+        assert!(matches!(e, PlcError::Intersect { .. }), "{e}");
+        // A box poking through another's face, sharing no point with it.
+        let mut p = unit_cube();
+        add_box(&mut p, [0.25, 0.25, 0.5], [0.75, 0.75, 1.5]);
+        let e = p.validate().unwrap_err();
+        assert!(matches!(e, PlcError::Intersect { .. }), "{e}");
     }
 
     #[test]
