@@ -30,7 +30,10 @@ fn main() {
         .warnings(false)
         .compile("tetgen_shim");
     if let Some(dir) = std::env::var_os("TETGEN_LIB_DIR") {
-        println!("cargo:rustc-link-search=native={}", PathBuf::from(dir).display());
+        println!(
+            "cargo:rustc-link-search=native={}",
+            PathBuf::from(dir).display()
+        );
     }
     println!("cargo:rustc-link-lib=dylib=tet");
 }

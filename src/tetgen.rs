@@ -62,7 +62,9 @@ pub enum TetgenError {
     #[error("TetGen's output is not a valid mesh: {0}")]
     InvalidOutput(String),
     /// TetGen's mesh does not fill the volume it should.
-    #[error("TetGen's mesh has volume {got} but the input encloses {expected} (switches -{switches})")]
+    #[error(
+        "TetGen's mesh has volume {got} but the input encloses {expected} (switches -{switches})"
+    )]
     VolumeMismatch {
         /// Volume of the input.
         expected: f64,
@@ -80,7 +82,10 @@ fn ffi_error(e: tetgen_ffi::Error) -> TetgenError {
 /// Switches this crate never passes to TetGen, with the reason.
 const REFUSED: [(char, &str); 10] = [
     ('r', "use `refine` to refine a mesh (-r)"),
-    ('c', "-c keeps the convex hull, so the mesh would not match the surface"),
+    (
+        'c',
+        "-c keeps the convex hull, so the mesh would not match the surface",
+    ),
     ('d', "-d only detects self-intersections and makes no mesh"),
     ('w', "-w (weighted Delaunay) is not supported"),
     ('v', "-v (Voronoi output) is not supported"),
@@ -187,7 +192,11 @@ fn build_mesh(out: tetgen_ffi::Output, switches: &str) -> Result<TetMesh, Tetgen
         let v = v as usize;
         if new_id[v] == u32::MAX {
             new_id[v] = points.len() as u32;
-            points.push([out.points[3 * v], out.points[3 * v + 1], out.points[3 * v + 2]]);
+            points.push([
+                out.points[3 * v],
+                out.points[3 * v + 1],
+                out.points[3 * v + 2],
+            ]);
         }
     }
     let tets: Vec<[u32; 4]> = out
@@ -231,7 +240,9 @@ fn build_mesh(out: tetgen_ffi::Output, switches: &str) -> Result<TetMesh, Tetgen
 
 /// Total volume of the live tets.
 fn mesh_volume(mesh: &TetMesh) -> f64 {
-    mesh.tet_ids().map(|t| tet_volume(&mesh.tet_points(t))).sum()
+    mesh.tet_ids()
+        .map(|t| tet_volume(&mesh.tet_points(t)))
+        .sum()
 }
 
 /// Volume per region.
@@ -243,12 +254,7 @@ fn region_volumes(mesh: &TetMesh) -> BTreeMap<i32, f64> {
     v
 }
 
-fn check_volume(
-    expected: f64,
-    got: f64,
-    slack: f64,
-    switches: &str,
-) -> Result<(), TetgenError> {
+fn check_volume(expected: f64, got: f64, slack: f64, switches: &str) -> Result<(), TetgenError> {
     if (got - expected).abs() <= 1e-9 * expected.abs() + 2.0 * slack {
         Ok(())
     } else {
@@ -345,8 +351,9 @@ pub fn tetrahedralize(plc: &Plc, opts: &Options) -> Result<TetMesh, TetgenError>
 /// Refines a tet mesh with TetGen (`-r`), keeping its boundary, its region
 /// interfaces and their markers, and its regions.
 ///
-/// Switches: `r`, the bounds of `opts`, `m` with a size field, then
-/// `opts.switches`. The mesh is compacted first; `opts.size_field` is
+/// Switches: `r`, the bounds of `opts`, `m` with a size field (and `q`,
+/// TetGen's default quality bound, when `opts` has none: TetGen applies the
+/// size field only while it refines for quality), then `opts.switches`. The mesh is compacted first; `opts.size_field` is
 /// indexed like `mesh`'s point slots. The result has the same volume per
 /// region as the input.
 pub fn refine(mesh: &TetMesh, opts: &Options) -> Result<TetMesh, TetgenError> {
@@ -376,7 +383,17 @@ pub fn refine(mesh: &TetMesh, opts: &Options) -> Result<TetMesh, TetgenError> {
             Some(s)
         }
     };
-    let sw = switches(opts, true, if sizes.is_some() { "m" } else { "" })?;
+    // TetGen applies a size field while it refines for quality: with a size
+    // field and no quality bound, ask for TetGen's default bound (`q`).
+    let quality = opts.min_ratio.is_some()
+        || opts.min_dihedral.is_some()
+        || opts.switches.as_deref().is_some_and(|s| s.contains('q'));
+    let extra = match (&sizes, quality) {
+        (None, _) => "",
+        (Some(_), true) => "m",
+        (Some(_), false) => "mq",
+    };
+    let sw = switches(opts, true, extra)?;
     let points: Vec<f64> = m.points().iter().flat_map(|p| p.to_array()).collect();
     let ids: Vec<u32> = m.tet_ids().collect();
     let tets: Vec<i32> = ids

@@ -224,7 +224,11 @@ fn reader_errors_name_file_and_line() {
     assert!(e.to_string().contains("not a finite number"), "{e}");
     let bad = cube_poly().replacen("4 1 3 4 2", "4 1 3 4 9", 1);
     let e = Plc::read(&write(dir.path(), "index.poly", &bad)).unwrap_err();
-    assert!(e.to_string().contains("index.poly:13: point index 9 is out of range 1..=8"), "{e}");
+    assert!(
+        e.to_string()
+            .contains("index.poly:13: point index 9 is out of range 1..=8"),
+        "{e}"
+    );
     let e = Plc::read(&write(dir.path(), "short.off", "OFF\n8 6 0\n0 0 0\n")).unwrap_err();
     assert!(e.to_string().contains("truncated"), "{e}");
     let e = Plc::read(&write(dir.path(), "junk.stl", "hello")).unwrap_err();

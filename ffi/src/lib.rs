@@ -323,11 +323,7 @@ fn validate(input: &Input) -> Result<(), Error> {
     if input.facet_polygon_counts.iter().any(|&c| c < 1) {
         return Err(invalid("a facet has no polygon"));
     }
-    let npoly: usize = input
-        .facet_polygon_counts
-        .iter()
-        .map(|&c| c as usize)
-        .sum();
+    let npoly: usize = input.facet_polygon_counts.iter().map(|&c| c as usize).sum();
     if npoly != input.polygon_vertex_counts.len() {
         return Err(invalid(format!(
             "facets name {npoly} polygons but {} polygon sizes are given",
@@ -351,20 +347,28 @@ fn validate(input: &Input) -> Result<(), Error> {
     check_indices(input.polygon_vertices, np, "a polygon")?;
     if let Some(m) = input.facet_markers {
         if m.len() != nf {
-            return Err(invalid(format!("{} facet markers for {nf} facets", m.len())));
+            return Err(invalid(format!(
+                "{} facet markers for {nf} facets",
+                m.len()
+            )));
         }
     }
     match input.facet_hole_counts {
         Some(h) => {
             if h.len() != nf {
-                return Err(invalid(format!("{} facet hole counts for {nf} facets", h.len())));
+                return Err(invalid(format!(
+                    "{} facet hole counts for {nf} facets",
+                    h.len()
+                )));
             }
             if h.iter().any(|&c| c < 0) {
                 return Err(invalid("a facet hole count is negative"));
             }
             let total: usize = h.iter().map(|&c| c as usize).sum();
             if 3 * total != input.facet_holes.len() {
-                return Err(invalid("facet hole coordinates do not match the hole counts"));
+                return Err(invalid(
+                    "facet hole coordinates do not match the hole counts",
+                ));
             }
         }
         None => {
@@ -392,7 +396,10 @@ fn validate(input: &Input) -> Result<(), Error> {
     check_indices(input.tets, np, "a tetrahedron")?;
     if let Some(a) = input.tet_attributes {
         if a.len() != nt {
-            return Err(invalid(format!("{} tet attributes for {nt} tetrahedra", a.len())));
+            return Err(invalid(format!(
+                "{} tet attributes for {nt} tetrahedra",
+                a.len()
+            )));
         }
         check_finite(a, "tet attribute")?;
     }
@@ -458,7 +465,9 @@ pub fn tetrahedralize(switches: &str, input: &Input) -> Result<Output, Error> {
         polygon_vertex_counts: ptr_or_null(input.polygon_vertex_counts),
         polygon_vertices: ptr_or_null(input.polygon_vertices),
         facet_markers: input.facet_markers.map_or(std::ptr::null(), ptr_or_null),
-        facet_hole_counts: input.facet_hole_counts.map_or(std::ptr::null(), ptr_or_null),
+        facet_hole_counts: input
+            .facet_hole_counts
+            .map_or(std::ptr::null(), ptr_or_null),
         facet_holes: ptr_or_null(input.facet_holes),
         nholes: (input.holes.len() / 3) as i32,
         holes: ptr_or_null(input.holes),
@@ -510,11 +519,22 @@ pub fn tetrahedralize(switches: &str, input: &Input) -> Result<Output, Error> {
         let trifacemarkers = copy_out(out.trifacemarkers, nf);
         let first = out.firstnumber;
         raw::tg_output_free(&mut out);
-        (points, all_tets, nc, all_attrs, na, trifaces, trifacemarkers, first)
+        (
+            points,
+            all_tets,
+            nc,
+            all_attrs,
+            na,
+            trifaces,
+            trifacemarkers,
+            first,
+        )
     };
     let (points, all_tets, nc, all_attrs, na, mut trifaces, trifacemarkers, first) = result;
     if nc != 0 && nc < 4 {
-        return Err(invalid(format!("TetGen returned {nc} nodes per tetrahedron")));
+        return Err(invalid(format!(
+            "TetGen returned {nc} nodes per tetrahedron"
+        )));
     }
     let mut tets = Vec::with_capacity(all_tets.len() / 10 * 4 + 4);
     if nc >= 4 {
@@ -546,8 +566,11 @@ pub fn tetrahedralize(switches: &str, input: &Input) -> Result<Output, Error> {
 mod tests {
     use super::*;
 
+    /// Points, polygons per facet, vertices per polygon, vertices, markers.
+    type Arrays = (Vec<f64>, Vec<i32>, Vec<i32>, Vec<i32>, Vec<i32>);
+
     /// The unit cube as six quadrilateral facets with markers 1..=6.
-    fn cube() -> (Vec<f64>, Vec<i32>, Vec<i32>, Vec<i32>, Vec<i32>) {
+    fn cube() -> Arrays {
         let mut p = Vec::new();
         for i in 0..8 {
             p.extend([(i & 1) as f64, ((i >> 1) & 1) as f64, ((i >> 2) & 1) as f64]);

@@ -7,8 +7,8 @@
 //! kinds and attribute tables are skipped. Written: the same sections.
 //! [`read_surface`] reads a triangles-only file as a surface to mesh.
 
-use super::text::{as_text, Tokens};
 use super::plc::Plc;
+use super::text::{as_text, Tokens};
 use super::{read_bytes, write_atomic, IoError};
 use crate::mesh::{MeshData, TetMesh};
 use std::io::Write;

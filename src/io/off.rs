@@ -41,9 +41,12 @@ pub fn read(path: &Path) -> Result<Plc, IoError> {
     let (l, counts) = if head.len() > 1 {
         (l, head[1..].to_vec())
     } else {
-        lines
-            .next()
-            .ok_or_else(|| err(l, "file ends where the vertex and face counts were expected".into()))?
+        lines.next().ok_or_else(|| {
+            err(
+                l,
+                "file ends where the vertex and face counts were expected".into(),
+            )
+        })?
     };
     let count = |tok: Option<&&str>, what: &str| -> Result<usize, IoError> {
         let tok = tok.ok_or_else(|| err(l, format!("{what} is missing")))?;
@@ -57,9 +60,12 @@ pub fn read(path: &Path) -> Result<Plc, IoError> {
     let mut points = Vec::with_capacity(nv);
     let mut last = l;
     for _ in 0..nv {
-        let (l, t) = lines
-            .next()
-            .ok_or_else(|| err(last, "file ends where a vertex was expected (truncated?)".into()))?;
+        let (l, t) = lines.next().ok_or_else(|| {
+            err(
+                last,
+                "file ends where a vertex was expected (truncated?)".into(),
+            )
+        })?;
         last = l;
         let mut p = [0.0; 3];
         for (k, what) in ["an x", "a y", "a z"].iter().enumerate() {
@@ -70,7 +76,10 @@ pub fn read(path: &Path) -> Result<Plc, IoError> {
                 .parse()
                 .map_err(|_| err(l, format!("expected {what} coordinate, found '{tok}'")))?;
             if !x.is_finite() {
-                return Err(err(l, format!("{what} coordinate is {x}, not a finite number")));
+                return Err(err(
+                    l,
+                    format!("{what} coordinate is {x}, not a finite number"),
+                ));
             }
             p[k] = x;
         }
@@ -78,15 +87,21 @@ pub fn read(path: &Path) -> Result<Plc, IoError> {
     }
     let mut facets = Vec::with_capacity(nf);
     for _ in 0..nf {
-        let (l, t) = lines
-            .next()
-            .ok_or_else(|| err(last, "file ends where a face was expected (truncated?)".into()))?;
+        let (l, t) = lines.next().ok_or_else(|| {
+            err(
+                last,
+                "file ends where a face was expected (truncated?)".into(),
+            )
+        })?;
         last = l;
         let k: i64 = t[0]
             .parse()
             .map_err(|_| err(l, format!("expected a face size, found '{}'", t[0])))?;
         if k < 3 {
-            return Err(err(l, format!("a face has {k} vertices; at least 3 are needed")));
+            return Err(err(
+                l,
+                format!("a face has {k} vertices; at least 3 are needed"),
+            ));
         }
         let k = k as usize;
         if t.len() < 1 + k {

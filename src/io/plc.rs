@@ -137,7 +137,9 @@ pub enum PlcError {
         other: usize,
     },
     /// An edge of a facet is shared with no other facet.
-    #[error("the surface is not closed: edge ({a}, {b}) of facet {facet} belongs to no other facet")]
+    #[error(
+        "the surface is not closed: edge ({a}, {b}) of facet {facet} belongs to no other facet"
+    )]
     Open {
         /// 1-based facet number.
         facet: usize,
@@ -367,6 +369,9 @@ struct Incidence {
     from_segment: bool,
 }
 
+/// Each edge (sorted canonical point ids) with the pieces that leave it.
+type EdgeIncidences = Vec<([u32; 2], Vec<Incidence>)>;
+
 struct UnionFind(Vec<u32>);
 
 impl UnionFind {
@@ -465,7 +470,10 @@ fn interior_point(loops: &[&[[f64; 2]]]) -> Option<[f64; 2]> {
     let mut ys: Vec<f64> = loops.iter().flat_map(|l| l.iter().map(|p| p[1])).collect();
     ys.sort_by(f64::total_cmp);
     ys.dedup();
-    let mut gaps: Vec<(f64, f64)> = ys.windows(2).map(|w| (w[1] - w[0], 0.5 * (w[0] + w[1]))).collect();
+    let mut gaps: Vec<(f64, f64)> = ys
+        .windows(2)
+        .map(|w| (w[1] - w[0], 0.5 * (w[0] + w[1])))
+        .collect();
     gaps.sort_by(|a, b| b.0.total_cmp(&a.0));
     for &(_, y) in gaps.iter().take(16) {
         let mut xs: Vec<f64> = Vec::new();
@@ -800,7 +808,7 @@ fn check_points(plc: &Plc) -> Result<(Vec<DVec3>, DVec3, Vec<u32>, f64), PlcErro
     let lo = surface.iter().fold(DVec3::INFINITY, |a, &p| a.min(p));
     let hi = surface.iter().fold(DVec3::NEG_INFINITY, |a, &p| a.max(p));
     for (axis, name) in ['x', 'y', 'z'].into_iter().enumerate() {
-        if !(hi[axis] > lo[axis]) {
+        if hi[axis] <= lo[axis] {
             return Err(PlcError::Flat { axis: name });
         }
     }
@@ -844,6 +852,7 @@ fn spans_volume(p: &[DVec3]) -> bool {
 impl Analysis {
     /// Splits every facet into pieces: each loop that no hole empties, minus
     /// the loops directly inside it.
+    #[allow(clippy::needless_range_loop)] // loops index several parallel arrays
     fn build_pieces(&mut self, hole_loops: &[Vec<bool>]) -> Result<(), PlcError> {
         let mut seen: HashMap<(Vec<u32>, Vec<Vec<u32>>), usize> = HashMap::new();
         for (fi, g) in self.facets.iter().enumerate() {
@@ -884,7 +893,7 @@ impl Analysis {
                 let inner: Vec<usize> = (0..nl).filter(|&c| parent[c] == Some(l)).collect();
                 let outer = &g.loops[l];
                 let area = outer.area - inner.iter().map(|&c| g.loops[c].area).sum::<f64>();
-                if !(area > 1e-12 * outer.area) {
+                if area <= 1e-12 * outer.area {
                     return Err(bad(
                         "the polygons inside one of its polygons cover it completely".into(),
                     ));
@@ -941,14 +950,14 @@ impl Analysis {
         &self,
         segments: &[(usize, [u32; 2])],
         hole_loops: &[Vec<bool>],
-    ) -> Result<Vec<([u32; 2], Vec<Incidence>)>, PlcError> {
+    ) -> Result<EdgeIncidences, PlcError> {
         let mut edges: HashMap<[u32; 2], Vec<Incidence>> = HashMap::new();
         let mut piece_of: HashMap<(usize, usize), usize> = HashMap::new();
         for (k, p) in self.pieces.iter().enumerate() {
             piece_of.insert((p.facet, p.outer), k);
             let g = &self.facets[p.facet];
-            for (is_outer, l) in std::iter::once((true, p.outer))
-                .chain(p.inner.iter().map(|&l| (false, l)))
+            for (is_outer, l) in
+                std::iter::once((true, p.outer)).chain(p.inner.iter().map(|&l| (false, l)))
             {
                 let lp = &g.loops[l];
                 // The piece lies left of a counter-clockwise outer loop and
@@ -970,7 +979,10 @@ impl Analysis {
         for &(fi, [a, b]) in segments {
             let g = &self.facets[fi];
             let mid = project(0.5 * (self.point(a) + self.point(b)), g.drop);
-            if g.loops.iter().any(|l| loop_distance(&l.uv, mid) <= self.tol) {
+            if g.loops
+                .iter()
+                .any(|l| loop_distance(&l.uv, mid) <= self.tol)
+            {
                 continue; // an edge of a loop already
             }
             let Some(l) = innermost_loop(g, mid) else {
@@ -1039,7 +1051,10 @@ impl Analysis {
     fn check_intersections(&self, edges: &[([u32; 2], Vec<Incidence>)]) -> Result<(), PlcError> {
         let np = self.pieces.len();
         let lo = self.pieces.iter().fold(DVec3::INFINITY, |a, p| a.min(p.lo));
-        let hi = self.pieces.iter().fold(DVec3::NEG_INFINITY, |a, p| a.max(p.hi));
+        let hi = self
+            .pieces
+            .iter()
+            .fold(DVec3::NEG_INFINITY, |a, p| a.max(p.hi));
         let ext = (hi - lo).max(DVec3::splat(self.tol));
         let h = (ext.x * ext.y * ext.z / np as f64).cbrt() * 1.5;
         let dims: [usize; 3] = [0, 1, 2].map(|a| ((ext[a] / h).ceil() as usize).clamp(1, 64));
@@ -1106,7 +1121,12 @@ impl Analysis {
                             } else if on_a || on_b {
                                 let (v, q) = if on_a { (e[0], a) } else { (e[1], b) };
                                 self.strictly_inside(k, q).then(|| {
-                                    format!("point {} of facet {} lies inside facet {}", v + 1, own + 1, p.facet + 1)
+                                    format!(
+                                        "point {} of facet {} lies inside facet {}",
+                                        v + 1,
+                                        own + 1,
+                                        p.facet + 1
+                                    )
                                 })
                             } else if (da > 0.0) != (db > 0.0) {
                                 let q = a + (b - a) * (da / (da - db));
@@ -1156,7 +1176,11 @@ impl Analysis {
                 .map(|i| {
                     let n = self.facets[self.pieces[i.piece as usize].facet].n;
                     // +1 when the piece's +n side faces increasing angles.
-                    let s = if n.dot(u.cross(i.d)) >= 0.0 { 1.0 } else { -1.0 };
+                    let s = if n.dot(u.cross(i.d)) >= 0.0 {
+                        1.0
+                    } else {
+                        -1.0
+                    };
                     (i.d.dot(e2).atan2(i.d.dot(e1)), s, i.piece)
                 })
                 .collect();
@@ -1248,12 +1272,7 @@ impl Analysis {
     }
 
     /// Groups shells into cells, locates the seeds and adds up the volumes.
-    fn cells(
-        &self,
-        plc: &Plc,
-        sides: &mut UnionFind,
-        diag: f64,
-    ) -> Result<PlcVolume, PlcError> {
+    fn cells(&self, plc: &Plc, sides: &mut UnionFind, diag: f64) -> Result<PlcVolume, PlcError> {
         let np = self.pieces.len();
         // Shells: components of glued sides, numbered densely.
         let mut shell_of_root: HashMap<u32, usize> = HashMap::new();
@@ -1370,10 +1389,10 @@ impl Analysis {
             }
         }
         let mut cell_volume: HashMap<u32, f64> = HashMap::new();
-        for sh in 0..ns {
+        for (sh, &v) in vol.iter().enumerate() {
             let c = cells.find(sh as u32);
             if outer_of_cell.contains_key(&c) {
-                *cell_volume.entry(c).or_default() += vol[sh];
+                *cell_volume.entry(c).or_default() += v;
             }
         }
         if let Some(v) = cell_volume.values().find(|&&v| v <= eps) {
@@ -1586,10 +1605,22 @@ mod tests {
             })
         };
         for x in 0..2 {
-            quad([id(x, 0, 0), id(x + 1, 0, 0), id(x + 1, 1, 0), id(x, 1, 0)], 1);
-            quad([id(x, 0, 1), id(x + 1, 0, 1), id(x + 1, 1, 1), id(x, 1, 1)], 2);
-            quad([id(x, 0, 0), id(x + 1, 0, 0), id(x + 1, 0, 1), id(x, 0, 1)], 3);
-            quad([id(x, 1, 0), id(x + 1, 1, 0), id(x + 1, 1, 1), id(x, 1, 1)], 4);
+            quad(
+                [id(x, 0, 0), id(x + 1, 0, 0), id(x + 1, 1, 0), id(x, 1, 0)],
+                1,
+            );
+            quad(
+                [id(x, 0, 1), id(x + 1, 0, 1), id(x + 1, 1, 1), id(x, 1, 1)],
+                2,
+            );
+            quad(
+                [id(x, 0, 0), id(x + 1, 0, 0), id(x + 1, 0, 1), id(x, 0, 1)],
+                3,
+            );
+            quad(
+                [id(x, 1, 0), id(x + 1, 1, 0), id(x + 1, 1, 1), id(x, 1, 1)],
+                4,
+            );
         }
         for x in 0..3 {
             quad([id(x, 0, 0), id(x, 1, 0), id(x, 1, 1), id(x, 0, 1)], 5);
@@ -1630,13 +1661,20 @@ mod tests {
     fn degenerate_inputs_are_rejected() {
         let mut p = unit_cube();
         p.points[3][1] = f64::NAN;
-        assert!(matches!(p.validate(), Err(PlcError::NonFinite { point: 4, .. })));
+        assert!(matches!(
+            p.validate(),
+            Err(PlcError::NonFinite { point: 4, .. })
+        ));
 
         let mut p = unit_cube();
         p.facets[1].polygons[0][2] = 99;
         assert!(matches!(
             p.validate(),
-            Err(PlcError::IndexOutOfRange { facet: 2, index: 100, .. })
+            Err(PlcError::IndexOutOfRange {
+                facet: 2,
+                index: 100,
+                ..
+            })
         ));
 
         let mut p = unit_cube();
@@ -1654,7 +1692,10 @@ mod tests {
 
         let mut p = unit_cube();
         p.facets[0].polygons[0] = vec![0, 2, 2, 1];
-        assert!(matches!(p.validate(), Err(PlcError::BadFacet { facet: 1, .. })));
+        assert!(matches!(
+            p.validate(),
+            Err(PlcError::BadFacet { facet: 1, .. })
+        ));
 
         let mut p = unit_cube();
         p.points[7] = [1.0, 1.0, 1.3];

@@ -19,7 +19,7 @@
 use super::plc::{Facet, Plc, Region};
 use super::text::as_text;
 use super::{read_bytes, IoError};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::str::FromStr;
 
 /// Non-empty lines of a file with comments removed, each with its 1-based
@@ -185,7 +185,7 @@ fn read_points(lines: &mut Lines, path: &Path) -> Result<(Vec<[f64; 3]>, i64), I
 }
 
 /// Points from a `.node` file (when the `.poly`/`.smesh` lists none).
-fn read_node_file(node: &PathBuf, from: &Path) -> Result<(Vec<[f64; 3]>, i64), IoError> {
+fn read_node_file(node: &Path, from: &Path) -> Result<(Vec<[f64; 3]>, i64), IoError> {
     if !node.is_file() {
         return Err(IoError::file(
             from,

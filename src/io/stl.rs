@@ -97,7 +97,10 @@ fn read_binary(path: &Path, bytes: &[u8], n: usize) -> Result<Plc, IoError> {
         if ids[0] == ids[1] || ids[1] == ids[2] || ids[0] == ids[2] {
             return Err(IoError::file(
                 path,
-                format!("triangle {} is degenerate: two of its vertices coincide", t + 1),
+                format!(
+                    "triangle {} is degenerate: two of its vertices coincide",
+                    t + 1
+                ),
             ));
         }
         tris.push((ids, 0));
@@ -115,7 +118,9 @@ fn expect(tok: &mut Tokens, word: &str) -> Result<(), IoError> {
             "expected '{word}', found '{}'",
             w.chars().take(24).collect::<String>()
         ))),
-        None => Err(tok.error(format!("file ends where '{word}' was expected (truncated?)"))),
+        None => Err(tok.error(format!(
+            "file ends where '{word}' was expected (truncated?)"
+        ))),
     }
 }
 
