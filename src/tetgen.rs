@@ -274,6 +274,8 @@ fn check_volume(expected: f64, got: f64, slack: f64, switches: &str) -> Result<(
 /// become the tets' regions), then `opts.switches`, and `Q` unless `V` or `Q`
 /// is there already. As in TetGen, the regions' maximum volumes apply only
 /// when the switches contain a bare `a` (e.g. `switches: Some("a".into())`).
+/// With `A`, a cell that no region seed names gets an attribute TetGen
+/// chooses (TetGen 1.5: one more than the largest given).
 pub fn tetrahedralize(plc: &Plc, opts: &Options) -> Result<TetMesh, TetgenError> {
     if opts.size_field.is_some() {
         return Err(TetgenError::Options(

@@ -554,7 +554,7 @@ impl Analysis {
         };
         let mut segments: Vec<(usize, [u32; 2])> = Vec::new();
         for (fi, f) in plc.facets.iter().enumerate() {
-            let (geom, segs) = a.facet_geometry(plc, fi, f, &canon, diag)?;
+            let (geom, segs) = a.facet_geometry(fi, f, &canon, diag)?;
             a.facets.push(geom);
             segments.extend(segs.into_iter().map(|s| (fi, s)));
         }
@@ -578,7 +578,6 @@ impl Analysis {
     /// Checks one facet and computes its plane, loops and segments.
     fn facet_geometry(
         &self,
-        plc: &Plc,
         fi: usize,
         f: &Facet,
         canon: &[u32],
@@ -590,16 +589,6 @@ impl Analysis {
         };
         if f.polygons.is_empty() {
             return Err(bad("it has no polygon".into()));
-        }
-        let np = plc.points.len();
-        for poly in &f.polygons {
-            if let Some(&v) = poly.iter().find(|&&v| v as usize >= np) {
-                return Err(PlcError::IndexOutOfRange {
-                    facet: fi + 1,
-                    index: v as u64 + 1,
-                    n_points: np,
-                });
-            }
         }
         let mut all: Vec<u32> = f
             .polygons
