@@ -231,8 +231,14 @@ fn cube_marker(c: DVec3) -> i32 {
 
 #[test]
 fn cube_poly_markers_land_on_the_boundary_faces() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("cube.poly");
+    write_poly(&path, &cube_plc());
+    let plc = Plc::read(&path).unwrap();
+    let markers: Vec<i32> = plc.facets.iter().map(|f| f.marker).collect();
+    assert_eq!(markers, vec![1, 2, 3, 4, 5, 6]);
     let mesh = tetrahedralize(
-        &cube_plc(),
+        &plc,
         &Options {
             min_ratio: Some(1.5),
             max_volume: Some(0.01),
