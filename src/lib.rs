@@ -13,6 +13,8 @@ pub mod refine;
 pub mod report;
 pub mod smooth;
 pub mod surface;
+#[cfg(feature = "tetgen")]
+pub mod tetgen;
 
 pub use mesh::{MeshData, TetMesh};
 pub use report::MeshStats;

@@ -25,6 +25,8 @@ enum Command {
     Improve(cli::improve::Args),
     /// Subdivide a polygon surface (√3, Loop, Catmull–Clark, Doo–Sabin, weighted Catmull–Clark).
     Surface(cli::surface::Args),
+    /// Mesh the volume a closed surface encloses, with TetGen (opt-in feature `tetgen`).
+    Mesh(cli::mesh::Args),
 }
 
 fn main() -> ExitCode {
@@ -35,6 +37,7 @@ fn main() -> ExitCode {
         Command::Refine(a) => cli::refine::run(a),
         Command::Improve(a) => cli::improve::run(a),
         Command::Surface(a) => cli::surface::run(a),
+        Command::Mesh(a) => cli::mesh::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

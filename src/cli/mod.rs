@@ -4,6 +4,7 @@
 pub mod convert;
 pub mod improve;
 pub mod progress;
+pub mod mesh;
 pub mod quality;
 pub mod refine;
 pub mod surface;

@@ -5,7 +5,9 @@
 //! is a feature, as MMG writes ridges and required edges there), `Ridges`,
 //! `RequiredEdges`, `Corners`, `RequiredVertices`. Sections of other element
 //! kinds and attribute tables are skipped. Written: the same sections.
+//! [`read_surface`] reads a triangles-only file as a surface to mesh.
 
+use super::plc::Plc;
 use super::text::{as_text, Tokens};
 use super::{read_bytes, write_atomic, IoError};
 use crate::mesh::{MeshData, TetMesh};
@@ -29,6 +31,37 @@ fn skipped_section_width(keyword: &str) -> Option<usize> {
 
 /// Reads a Medit `.mesh` ASCII file.
 pub fn read(path: &Path) -> Result<MeshData, IoError> {
+    let data = parse(path)?;
+    if data.tets.is_empty() {
+        return Err(IoError::file(
+            path,
+            "no Tetrahedra section: not a volume mesh",
+        ));
+    }
+    Ok(data)
+}
+
+/// Reads a Medit `.mesh` file that describes a closed surface by its
+/// `Triangles` (their refs become facet markers) as a [`Plc`] to mesh.
+pub fn read_surface(path: &Path) -> Result<Plc, IoError> {
+    let data = parse(path)?;
+    if !data.tets.is_empty() {
+        return Err(IoError::file(
+            path,
+            "holds Tetrahedra: a surface to mesh must hold Triangles only",
+        ));
+    }
+    if data.triangles.is_empty() {
+        return Err(IoError::file(
+            path,
+            "no Triangles section: there is no surface to mesh",
+        ));
+    }
+    Ok(Plc::from_triangles(data.points, &data.triangles))
+}
+
+/// Reads every section of a Medit file, without requiring tetrahedra.
+fn parse(path: &Path) -> Result<MeshData, IoError> {
     let bytes = read_bytes(path)?;
     let text = as_text(path, &bytes)?;
     let mut tok = Tokens::new(path, text, true);
@@ -164,12 +197,6 @@ pub fn read(path: &Path) -> Result<MeshData, IoError> {
         return Err(IoError::file(path, "empty file"));
     }
     let _ = saw_end; // End is optional in practice (many writers omit it).
-    if data.tets.is_empty() {
-        return Err(IoError::file(
-            path,
-            "no Tetrahedra section: not a volume mesh",
-        ));
-    }
     data.edges = raw_edges;
     let _ = ridges; // every listed edge is already a feature
     Ok(data)

@@ -10,6 +10,10 @@ pub mod gid;
 pub mod gmsh;
 pub mod medit;
 pub mod tetgen;
+pub mod off;
+pub mod plc;
+pub mod poly;
+pub mod stl;
 mod text;
 pub mod vtk;
 

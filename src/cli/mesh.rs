@@ -1,0 +1,77 @@
+//! `tetrefine mesh IN -o OUT [--min-ratio R] [--min-dihedral DEG] [--max-volume V] [--switches S]`:
+//! a surface to a tetrahedral mesh with TetGen (opt-in feature `tetgen`).
+
+use std::path::PathBuf;
+
+/// Arguments of `mesh`.
+#[derive(clap::Args)]
+pub struct Args {
+    /// Input surface: TetGen .poly or .smesh, .off, .stl (ASCII or binary), or a
+    /// Medit .mesh holding triangles only.
+    pub input: PathBuf,
+    /// Output mesh; the format follows the extension (.mesh, …).
+    #[arg(short, long)]
+    pub output: PathBuf,
+    /// Largest radius-edge ratio of a tet (TetGen -q; at least 1.0).
+    #[arg(long, value_name = "R")]
+    pub min_ratio: Option<f64>,
+    /// Smallest dihedral angle in degrees (TetGen -q<R>/<DEG>; R defaults to 2.0).
+    #[arg(long, value_name = "DEG")]
+    pub min_dihedral: Option<f64>,
+    /// Largest tet volume (TetGen -a).
+    #[arg(long, value_name = "V")]
+    pub max_volume: Option<f64>,
+    /// More TetGen switches, appended after the ones above (e.g. pq1.414a0.002A).
+    #[arg(long, value_name = "S", allow_hyphen_values = true)]
+    pub switches: Option<String>,
+}
+
+/// The one line a build without TetGen answers.
+#[cfg(not(feature = "tetgen"))]
+const NO_TETGEN: &str = "built without TetGen: rebuild with `--features tetgen` (TetGen is AGPL-3)";
+
+/// Runs `mesh`.
+#[cfg(not(feature = "tetgen"))]
+pub fn run(_a: Args) -> super::CliResult {
+    Err(NO_TETGEN.to_string())
+}
+
+/// Runs `mesh`.
+#[cfg(feature = "tetgen")]
+pub fn run(a: Args) -> super::CliResult {
+    use tetrefine::io::plc::Plc;
+    use tetrefine::tetgen::{tetrahedralize, Options};
+    tetrefine::io::Format::for_writing(&a.output).map_err(|e| e.to_string())?;
+    let opts = Options {
+        min_ratio: a.min_ratio,
+        min_dihedral: a.min_dihedral,
+        max_volume: a.max_volume,
+        switches: a.switches,
+        size_field: None,
+    };
+    // Options are checked before the (possibly large) input is read.
+    tetrefine::tetgen::switches(&opts, false, "").map_err(|e| e.to_string())?;
+    let plc = Plc::read(&a.input).map_err(|e| e.to_string())?;
+    let mesh = tetrahedralize(&plc, &opts).map_err(|e| format!("{}: {e}", a.input.display()))?;
+    tetrefine::io::write_mesh(&a.output, &mesh).map_err(|e| e.to_string())?;
+    if let Some(want) = opts.min_dihedral {
+        let worst = tetrefine::MeshStats::compute(&mesh).min_dihedral_deg.worst;
+        if worst < want {
+            eprintln!(
+                "note: the worst dihedral angle is {worst:.2}°, below the {want}° asked for: \
+                 TetGen's dihedral bound is a goal, not a guarantee (see README)"
+            );
+        }
+    }
+    let mut regions: Vec<i32> = mesh.tet_ids().map(|t| mesh.region(t)).collect();
+    regions.sort_unstable();
+    regions.dedup();
+    println!(
+        "{}: {} points, {} tetrahedra, regions {:?}",
+        a.output.display(),
+        mesh.n_points(),
+        mesh.n_tets(),
+        regions
+    );
+    Ok(())
+}
