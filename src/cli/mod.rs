@@ -3,8 +3,8 @@
 
 pub mod convert;
 pub mod improve;
-pub mod progress;
 pub mod mesh;
+pub mod progress;
 pub mod quality;
 pub mod refine;
 pub mod surface;
@@ -41,7 +41,9 @@ pub fn load(path: &std::path::Path) -> Result<tetrefine::TetMesh, String> {
 
 /// Checks a histogram path's extension before any work is done.
 pub fn check_histogram_path(path: &Path) -> CliResult {
-    HistogramFormat::from_path(path).map(|_| ()).map_err(|e| e.to_string())
+    HistogramFormat::from_path(path)
+        .map(|_| ())
+        .map_err(|e| e.to_string())
 }
 
 /// Writes the min-dihedral histogram of `stats` (CSV, SVG or PNG).
@@ -61,8 +63,14 @@ pub fn write_refined(path: &Path, mesh: &mut TetMesh, extra: Vec<CellArray>) -> 
     if is_vtu {
         let ids: Vec<u32> = mesh.tet_ids().collect();
         let mut cells = vec![
-            CellArray::Int32("level".into(), ids.iter().map(|&t| i32::from(mesh.level(t))).collect()),
-            CellArray::Int32("parent".into(), ids.iter().map(|&t| mesh.parent(t) as i32).collect()),
+            CellArray::Int32(
+                "level".into(),
+                ids.iter().map(|&t| i32::from(mesh.level(t))).collect(),
+            ),
+            CellArray::Int32(
+                "parent".into(),
+                ids.iter().map(|&t| mesh.parent(t) as i32).collect(),
+            ),
         ];
         cells.extend(extra);
         tetrefine::io::vtk::write_vtu(path, mesh, &cells).map_err(|e| e.to_string())

@@ -12,7 +12,9 @@ pub struct BarProgress {
 impl BarProgress {
     /// A progress display with nothing shown yet.
     pub fn new() -> BarProgress {
-        BarProgress { bar: Mutex::new(None) }
+        BarProgress {
+            bar: Mutex::new(None),
+        }
     }
 }
 

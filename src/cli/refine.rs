@@ -4,7 +4,9 @@
 use super::progress::BarProgress;
 use std::path::PathBuf;
 use std::time::Instant;
-use tetrefine::refine::{locate_parents, refine_step_with_progress, BoundaryRule, Phase, RefineOptions};
+use tetrefine::refine::{
+    locate_parents, refine_step_with_progress, BoundaryRule, Phase, RefineOptions,
+};
 use tetrefine::report::steps::{step_row, step_table_header, StepStats};
 use tetrefine::MeshStats;
 
@@ -53,7 +55,10 @@ pub fn run(a: Args) -> super::CliResult {
         super::check_histogram_path(h)?;
     }
     if !(a.threshold > 0.0 && a.threshold < 1.0) {
-        return Err(format!("--threshold {} must lie in (0, 1) (a sine)", a.threshold));
+        return Err(format!(
+            "--threshold {} must lie in (0, 1) (a sine)",
+            a.threshold
+        ));
     }
     let input = super::load(&a.input)?;
     let mut mesh = input.clone();
@@ -85,7 +90,8 @@ pub fn run(a: Args) -> super::CliResult {
     }
     locate_parents(&input, &mut mesh);
     if let Some(path) = &a.stats {
-        let text = serde_json::to_string_pretty(&StatsFile { steps: &steps }).map_err(|e| e.to_string())?;
+        let text = serde_json::to_string_pretty(&StatsFile { steps: &steps })
+            .map_err(|e| e.to_string())?;
         tetrefine::io::write_atomic(path, |w| std::io::Write::write_all(w, text.as_bytes()))
             .map_err(|e| e.to_string())?;
     }

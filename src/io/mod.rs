@@ -9,11 +9,11 @@
 pub mod gid;
 pub mod gmsh;
 pub mod medit;
-pub mod tetgen;
 pub mod off;
 pub mod plc;
 pub mod poly;
 pub mod stl;
+pub mod tetgen;
 mod text;
 pub mod vtk;
 

@@ -19,6 +19,7 @@ mod check;
 mod compact;
 mod data;
 pub mod generate;
+mod reorder;
 
 pub use build::{BuildReport, MeshError};
 pub use check::CheckError;

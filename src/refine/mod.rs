@@ -12,6 +12,10 @@
 //!    boundary points; a move that would invert a tet is shortened or skipped;
 //! 6. `optimize` — interior edge removal and vertex smoothing
 //!    ([`crate::smooth::improve`]).
+//!
+//! A step renumbers tets and points (it compacts the mesh and sorts it along
+//! a space-filling curve before `optimize`), so ids held across a step are
+//! stale; `parent` and `level` carry what callers need.
 
 pub mod features;
 pub mod parents;

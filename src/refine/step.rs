@@ -65,6 +65,9 @@ pub fn refine_step_with_progress(
             Phase::BoundaryFlip => boundary_flip_phase(mesh, &st, &mut report),
             Phase::BoundarySmooth => boundary_smooth_phase(mesh, &st, opts, &mut report),
             Phase::Optimize => {
+                // The topological phases appended tets and points at the ends
+                // of the arrays; bring neighbours together in memory first.
+                mesh.reorder_spatially();
                 if opts.opt_passes > 0 {
                     report.improve = improve(
                         mesh,
