@@ -1,7 +1,7 @@
 //! Laplacian smoothing: the vertex goes to the centroid of its neighbours
 //! (Field 1988), kept only if the worst tet of its ball improves.
 
-use super::{ball_quality_at, ball_stays_positive, vertex_neighbours};
+use super::{ball_min_mean_at, ball_stays_positive, vertex_neighbours};
 use crate::mesh::TetMesh;
 use glam::DVec3;
 
@@ -15,8 +15,8 @@ pub fn laplacian_target(mesh: &TetMesh, v: u32, ball: &[u32], scratch: &mut Vec<
 }
 
 /// Moves `v` to its Laplacian target if that raises the ball's worst quality
-/// above `current` without inverting anything. Returns the new worst quality
-/// if it moved.
+/// above `current` without lowering the ball's mean quality or inverting
+/// anything. Returns the new worst quality if it moved.
 pub fn laplacian_smooth(
     mesh: &mut TetMesh,
     v: u32,
@@ -25,8 +25,8 @@ pub fn laplacian_smooth(
     scratch: &mut Vec<u32>,
 ) -> Option<f64> {
     let x = laplacian_target(mesh, v, ball, scratch);
-    let q = ball_quality_at(mesh, v, ball, x);
-    if q > current && ball_stays_positive(mesh, v, ball, x) {
+    let (q, mean) = ball_min_mean_at(mesh, v, ball, x);
+    if q > current && mean >= ball_min_mean_at(mesh, v, ball, mesh.point(v)).1 && ball_stays_positive(mesh, v, ball, x) {
         mesh.set_point(v, x);
         Some(q)
     } else {

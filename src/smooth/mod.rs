@@ -30,6 +30,25 @@ pub fn ball_quality_at(mesh: &TetMesh, v: u32, ball: &[u32], x: DVec3) -> f64 {
     q
 }
 
+/// Smallest and mean quality over the tets of `ball` if vertex `v` stood at `x`.
+pub fn ball_min_mean_at(mesh: &TetMesh, v: u32, ball: &[u32], x: DVec3) -> (f64, f64) {
+    let mut q = f64::INFINITY;
+    let mut sum = 0.0;
+    for &t in ball {
+        let tv = mesh.tet(t);
+        let mut p = mesh.tet_points(t);
+        for i in 0..4 {
+            if tv[i] == v {
+                p[i] = x;
+            }
+        }
+        let s = tet_min_sine(&p);
+        q = q.min(s);
+        sum += s;
+    }
+    (q, sum / ball.len().max(1) as f64)
+}
+
 /// Smallest quality over the tets of `ball` as they stand.
 pub fn ball_quality(mesh: &TetMesh, ball: &[u32]) -> f64 {
     ball.iter()
