@@ -19,7 +19,7 @@ pub struct Args {
     /// (bin_lo_deg,bin_hi_deg,count), .svg or .png.
     #[arg(long, value_name = "FILE")]
     pub histogram: Option<PathBuf>,
-    /// Number of equal histogram bins over 0–71° (default: 71 bins of 1°).
+    /// Number of equal histogram bins over 0–71° (71: bins of 1°).
     #[arg(long, value_name = "N", default_value_t = tetrefine::report::stats::DEFAULT_BINS)]
     pub bins: usize,
     /// Also write the mesh (format by extension; .vtu carries the quality arrays).
