@@ -59,6 +59,12 @@ pub fn run(a: Args) -> super::CliResult {
         print!("{}", format_table(&[(name.as_str(), &stats)]));
     }
 
+    // The mesh first: its writer is the likelier to refuse (format support),
+    // and then no file at all is left behind.
+    if let Some(o) = &a.output {
+        tetrefine::io::write_mesh(o, &mesh).map_err(|e| e.to_string())?;
+        eprintln!("wrote mesh {}", o.display());
+    }
     if let Some(h) = &a.histogram {
         let title = format!(
             "{}: minimum dihedral angle of {} tetrahedra",
@@ -67,10 +73,6 @@ pub fn run(a: Args) -> super::CliResult {
         );
         write_histogram(h, &stats.histogram, &title).map_err(|e| e.to_string())?;
         eprintln!("wrote histogram {}", h.display());
-    }
-    if let Some(o) = &a.output {
-        tetrefine::io::write_mesh(o, &mesh).map_err(|e| e.to_string())?;
-        eprintln!("wrote mesh {}", o.display());
     }
     Ok(())
 }
