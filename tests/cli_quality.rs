@@ -364,6 +364,17 @@ fn zero_bins_is_refused() {
 }
 
 #[test]
+fn absurd_bin_counts_are_refused_not_allocated() {
+    for bins in ["10001", "1000000000000"] {
+        let o = tetrefine(&["quality", TRIPOD, "--bins", bins]);
+        assert_one_line_error(&o, "--bins");
+    }
+    let o = tetrefine(&["quality", TRIPOD, "--bins", "-3"]);
+    assert!(!o.status.success());
+    assert!(o.stdout.is_empty());
+}
+
+#[test]
 fn missing_input_names_the_file() {
     let o = tetrefine(&["quality", "meshes/no_such_mesh.mesh", "--json"]);
     assert_one_line_error(&o, "no_such_mesh.mesh");

@@ -6,6 +6,10 @@ use tetrefine::report::stats::DEFAULT_HIST_MAX_DEG;
 use tetrefine::report::{format_table, Histogram};
 use tetrefine::MeshStats;
 
+/// Most histogram bins accepted (0.0071° each over 0–71°); every parallel task
+/// keeps its own counts, so the number is bounded.
+const MAX_BINS: usize = 10_000;
+
 /// Arguments of `quality`.
 #[derive(clap::Args)]
 pub struct Args {
@@ -19,7 +23,7 @@ pub struct Args {
     /// (bin_lo_deg,bin_hi_deg,count), .svg or .png.
     #[arg(long, value_name = "FILE")]
     pub histogram: Option<PathBuf>,
-    /// Number of equal histogram bins over 0–71° (default: 71 bins of 1°).
+    /// Number of equal histogram bins over 0–71° (71: bins of 1°; at most 10000).
     #[arg(long, value_name = "N", default_value_t = tetrefine::report::stats::DEFAULT_BINS)]
     pub bins: usize,
     /// Also write the mesh (format by extension; .vtu carries the quality arrays).
@@ -38,8 +42,11 @@ fn file_name(path: &Path) -> String {
 /// statistics once and prints / writes what was asked.
 pub fn run(a: Args) -> super::CliResult {
     // Everything that can be refused without reading the mesh is refused first.
-    if a.bins == 0 {
-        return Err("--bins must be at least 1".into());
+    if a.bins == 0 || a.bins > MAX_BINS {
+        return Err(format!(
+            "--bins must be between 1 and {MAX_BINS} (got {})",
+            a.bins
+        ));
     }
     if let Some(h) = &a.histogram {
         HistogramFormat::from_path(h).map_err(|e| e.to_string())?;
@@ -59,6 +66,12 @@ pub fn run(a: Args) -> super::CliResult {
         print!("{}", format_table(&[(name.as_str(), &stats)]));
     }
 
+    // The mesh first: its writer is the likelier to refuse (format support),
+    // and then no file at all is left behind.
+    if let Some(o) = &a.output {
+        tetrefine::io::write_mesh(o, &mesh).map_err(|e| e.to_string())?;
+        eprintln!("wrote mesh {}", o.display());
+    }
     if let Some(h) = &a.histogram {
         let title = format!(
             "{}: minimum dihedral angle of {} tetrahedra",
@@ -67,10 +80,6 @@ pub fn run(a: Args) -> super::CliResult {
         );
         write_histogram(h, &stats.histogram, &title).map_err(|e| e.to_string())?;
         eprintln!("wrote histogram {}", h.display());
-    }
-    if let Some(o) = &a.output {
-        tetrefine::io::write_mesh(o, &mesh).map_err(|e| e.to_string())?;
-        eprintln!("wrote mesh {}", o.display());
     }
     Ok(())
 }
