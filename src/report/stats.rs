@@ -663,6 +663,12 @@ impl MeshStats {
                 }
             }
         }
+        let mut edges = acc.edges;
+        for ([a, b], extra) in pinched_boundary_edges(mesh) {
+            edges -= extra as usize;
+            valence[a as usize] -= extra;
+            valence[b as usize] -= extra;
+        }
         let nodes = valence.iter().filter(|&&x| x > 0).count();
         let vmax = valence.iter().copied().max().unwrap_or(0);
 
@@ -674,7 +680,7 @@ impl MeshStats {
         let n = acc.tets.max(1) as f64;
         MeshStats {
             nodes,
-            edges: acc.edges,
+            edges,
             tets: acc.tets,
             boundary_faces: acc.boundary,
             interior_faces: (4 * acc.tets - acc.boundary) / 2,
@@ -689,7 +695,7 @@ impl MeshStats {
             },
             valence: Valence {
                 avg: if nodes > 0 {
-                    2.0 * acc.edges as f64 / nodes as f64
+                    2.0 * edges as f64 / nodes as f64
                 } else {
                     0.0
                 },
@@ -718,8 +724,38 @@ impl MeshStats {
                 }
             }
         }
+        for ([a, b], extra) in pinched_boundary_edges(mesh) {
+            valence[a as usize] -= extra;
+            valence[b as usize] -= extra;
+        }
         valence
     }
+}
+
+/// Boundary edges where the domain touches itself (more than two boundary
+/// faces, i.e. several fans of tets around the edge), each with the number
+/// of fans beyond the first. The ring walks of [`edge_owner_mask`] see one
+/// fan at a time, so each fan elects an owner; the statistics subtract the
+/// extra owners. Sorted, for determinism.
+fn pinched_boundary_edges(mesh: &TetMesh) -> Vec<([u32; 2], u32)> {
+    let mut count: std::collections::HashMap<[u32; 2], u32> = std::collections::HashMap::new();
+    for t in mesh.tet_ids() {
+        for f in 0..4 {
+            if mesh.is_boundary_face(t, f) {
+                let v = mesh.face_vertices(t, f);
+                for i in 0..3 {
+                    *count.entry(crate::mesh::edge_key(v[i], v[(i + 1) % 3])).or_default() += 1;
+                }
+            }
+        }
+    }
+    let mut out: Vec<([u32; 2], u32)> = count
+        .into_iter()
+        .filter(|&(_, c)| c > 2)
+        .map(|(e, c)| (e, c / 2 - 1))
+        .collect();
+    out.sort_unstable();
+    out
 }
 
 fn finite_or_zero(x: f64) -> f64 {
@@ -860,6 +896,33 @@ mod tests {
                 assert_eq!(edge_owner_mask(&mesh, t), by_walk);
             }
         }
+    }
+
+    #[test]
+    fn edges_where_the_domain_touches_itself_count_once() {
+        // Two cubes of the grid sharing only an edge: the edge has two fans.
+        let full = cube_grid(2);
+        let keep = |t: &[u32; 4]| {
+            let c = t.iter().fold([0.0; 3], |acc, &v| {
+                let p = full.points[v as usize];
+                [acc[0] + p[0], acc[1] + p[1], acc[2] + p[2]]
+            });
+            // Cube (0,0,*) and cube (1,1,*): x and y both below or above 1/2.
+            let (x, y) = (c[0] / 4.0, c[1] / 4.0);
+            (x < 0.5) == (y < 0.5)
+        };
+        let data = MeshData {
+            points: full.points.clone(),
+            tets: full.tets.iter().copied().filter(keep).collect(),
+            ..Default::default()
+        };
+        let (m, _) = TetMesh::from_data(&data).unwrap();
+        m.check().unwrap();
+        assert!(!pinched_boundary_edges(&m).is_empty());
+        let (edges, valence) = edges_by_hashing(&m);
+        let s = MeshStats::compute(&m);
+        assert_eq!(s.edges, edges);
+        assert_eq!(MeshStats::vertex_valence(&m), valence);
     }
 
     #[test]
