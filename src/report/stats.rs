@@ -118,6 +118,12 @@ pub struct MeshStats {
     pub regions: BTreeMap<String, usize>,
     /// Histogram of the per-tet minimum dihedral angle.
     pub histogram: Histogram,
+    /// Tagged feature (crease) edges.
+    #[serde(default)]
+    pub feature_edges: usize,
+    /// Corner vertices.
+    #[serde(default)]
+    pub corners: usize,
 }
 
 /// Bit `e` is set when `t` is the smallest tet id around its local edge `e`, so
@@ -708,6 +714,8 @@ impl MeshStats {
                 .map(|(k, v)| (k.to_string(), v))
                 .collect(),
             histogram,
+            feature_edges: mesh.feature_edges().len(),
+            corners: mesh.corners().len(),
         }
     }
 

@@ -77,6 +77,14 @@ const ROWS: &[Row] = &[
         value: |s| s.inverted.to_string(),
     },
     Row {
+        label: "feature edges",
+        value: |s| s.feature_edges.to_string(),
+    },
+    Row {
+        label: "corners",
+        value: |s| s.corners.to_string(),
+    },
+    Row {
         label: "volume",
         value: |s| significant(s.volume),
     },
