@@ -10,6 +10,7 @@ pub mod medit;
 mod text;
 
 pub use text::Tokens;
+pub(crate) use text::as_text;
 
 use crate::mesh::{MeshData, TetMesh};
 use std::fmt;
