@@ -9,8 +9,8 @@
 pub mod medit;
 mod text;
 
-pub use text::Tokens;
 pub(crate) use text::as_text;
+pub use text::Tokens;
 
 use crate::mesh::{MeshData, TetMesh};
 use std::fmt;

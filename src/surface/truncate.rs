@@ -192,6 +192,17 @@ mod tests {
         );
     }
 
+    /// The largest distance of a face's vertex to the face's best-fit plane.
+    fn worst_plane_deviation(mesh: &PolyMesh) -> f64 {
+        mesh.faces
+            .iter()
+            .map(|f| {
+                let pts: Vec<DVec3> = f.iter().map(|&i| mesh.points[i as usize]).collect();
+                plane_deviation(&pts)
+            })
+            .fold(0.0, f64::max)
+    }
+
     #[test]
     fn planar_faces_with_3_valent_vertices_stay_planar() {
         let mut inputs = vec![
@@ -215,15 +226,7 @@ mod tests {
                 );
             }
             for k in 1..=4 {
-                let out = truncate(&mesh, k).expect("ok");
-                let worst = out
-                    .faces
-                    .iter()
-                    .map(|f| {
-                        let pts: Vec<DVec3> = f.iter().map(|&i| out.points[i as usize]).collect();
-                        plane_deviation(&pts)
-                    })
-                    .fold(0.0, f64::max);
+                let worst = worst_plane_deviation(&truncate(&mesh, k).expect("ok"));
                 assert!(
                     worst < 1e-12,
                     "{name}, {k} steps: face off its plane by {worst}"
@@ -236,15 +239,7 @@ mod tests {
     fn non_3_valent_vertices_give_non_planar_faces() {
         // The counter-case the paper describes: the icosphere's 5- and
         // 6-valent vertices are not coplanar with their quarter points.
-        let out = truncate(&icosphere(1), 1).expect("ok");
-        let worst = out
-            .faces
-            .iter()
-            .map(|f| {
-                let pts: Vec<DVec3> = f.iter().map(|&i| out.points[i as usize]).collect();
-                plane_deviation(&pts)
-            })
-            .fold(0.0, f64::max);
+        let worst = worst_plane_deviation(&truncate(&icosphere(1), 1).expect("ok"));
         assert!(worst > 1e-4, "{worst}");
     }
 
