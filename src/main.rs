@@ -19,7 +19,8 @@ enum Command {
     Quality(cli::quality::Args),
     /// Convert a mesh between formats, keeping regions, markers and features.
     Convert(cli::convert::Args),
-    /// Subdivide a polygon surface (√3, Loop, Catmull–Clark, Doo–Sabin, weighted Catmull–Clark).
+    /// Subdivide a polygon surface (√3, Loop, Catmull–Clark, Doo–Sabin, weighted Catmull–Clark,
+    /// Sierpinski, vertex truncation) or draw a subdivision IFS attractor.
     Surface(cli::surface::Args),
 }
 

@@ -82,6 +82,20 @@ impl Default for SierpinskiOptions {
     }
 }
 
+impl SierpinskiOptions {
+    /// Checks the options: the neck lies strictly between 0 and 0.5.
+    pub fn check(&self) -> Result<(), SurfaceError> {
+        let neck = self.neck;
+        if neck > 0.0 && neck < 0.5 {
+            Ok(())
+        } else {
+            Err(SurfaceError::Parameter(format!(
+                "the Sierpinski neck must lie strictly between 0 and 0.5, got {neck}"
+            )))
+        }
+    }
+}
+
 /// `steps` Sierpinski steps (seed paper `000`) on a closed, consistently
 /// oriented manifold polygon mesh, with the default [`SierpinskiOptions`].
 ///
@@ -99,12 +113,8 @@ pub fn sierpinski_with(
     steps: usize,
     options: &SierpinskiOptions,
 ) -> Result<PolyMesh, SurfaceError> {
+    options.check()?;
     let neck = options.neck;
-    if !(neck > 0.0 && neck < 0.5) {
-        return Err(SurfaceError::Parameter(format!(
-            "the Sierpinski neck must lie strictly between 0 and 0.5, got {neck}"
-        )));
-    }
     let he = closed_half_edges(mesh)?;
     if steps == 0 {
         return Ok(mesh.clone());

@@ -34,14 +34,21 @@ pub fn truncate(mesh: &PolyMesh, steps: usize) -> Result<PolyMesh, SurfaceError>
     truncate_with(mesh, steps, 0.25)
 }
 
+/// Checks a truncation cut: it lies strictly between 0 and 0.5.
+pub fn check_cut(cut: f64) -> Result<(), SurfaceError> {
+    if cut > 0.0 && cut < 0.5 {
+        Ok(())
+    } else {
+        Err(SurfaceError::Parameter(format!(
+            "the truncation cut must lie strictly between 0 and 0.5, got {cut}"
+        )))
+    }
+}
+
 /// Vertex truncation that cuts every edge at `cut` and `1 − cut` of its length
 /// (`0 < cut < 0.5`; Chaikin's rule, and [`truncate`], is `cut = 0.25`).
 pub fn truncate_with(mesh: &PolyMesh, steps: usize, cut: f64) -> Result<PolyMesh, SurfaceError> {
-    if !(cut > 0.0 && cut < 0.5) {
-        return Err(SurfaceError::Parameter(format!(
-            "the truncation cut must lie strictly between 0 and 0.5, got {cut}"
-        )));
-    }
+    check_cut(cut)?;
     let he = closed_half_edges(mesh)?;
     let estimate = he.len() as f64 * 3f64.powi(steps.min(64) as i32);
     if estimate > i32::MAX as f64 {
