@@ -21,7 +21,7 @@ enum Command {
     Convert(cli::convert::Args),
     /// Subdivide a polygon surface (√3, Loop, Catmull–Clark, Doo–Sabin, weighted Catmull–Clark,
     /// Sierpinski, vertex truncation) or draw a subdivision IFS attractor.
-    Surface(cli::surface::Args),
+    Surface(Box<cli::surface::Args>),
 }
 
 fn main() -> ExitCode {
@@ -29,7 +29,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Quality(a) => cli::quality::run(a),
         Command::Convert(a) => cli::convert::run(a),
-        Command::Surface(a) => cli::surface::run(a),
+        Command::Surface(a) => cli::surface::run(*a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -1,6 +1,6 @@
 //! VTK XML PolyData `.vtp` (ASCII data arrays), the surface format ParaView
 //! opens directly. Points are `Float64`; cells are written as VTK's
-//! `connectivity` and `offsets` arrays (`Int64`). [`write`] writes a polygon
+//! `connectivity` and `offsets` arrays (`Int64`). [`write()`] writes a polygon
 //! mesh (`Polys`); the pieces below it are shared with the point and polyline
 //! writers of [`super::ifs`] (`Verts`, `Lines`).
 
