@@ -5,7 +5,7 @@ use tetrefine::surface::catmull_clark::catmull_clark;
 use tetrefine::surface::catmull_clark_weighted::{catmull_clark_weighted, WeightedConfig};
 use tetrefine::surface::doo_sabin::doo_sabin;
 use tetrefine::surface::ifs::{
-    gasket_control, ifs_attractor, koch_control, write_polylines_csv, write_polylines_vtp,
+    gasket_control, ifs_attractor, koch_control, write_polylines, PolylineFormat,
 };
 use tetrefine::surface::loop_scheme::loop_subdivide;
 use tetrefine::surface::sierpinski::{sierpinski_with, SierpinskiOptions};
@@ -190,32 +190,9 @@ fn check_options(a: &Args, features: &Features) -> Result<(), String> {
     Ok(())
 }
 
-/// Where `ifs` writes its polylines.
-#[derive(Clone, Copy, PartialEq, Eq)]
-enum PolylineFormat {
-    Vtp,
-    Csv,
-}
-
-fn polyline_format(path: &std::path::Path) -> Result<PolylineFormat, String> {
-    let ext = path
-        .extension()
-        .and_then(|e| e.to_str())
-        .unwrap_or("")
-        .to_ascii_lowercase();
-    match ext.as_str() {
-        "vtp" => Ok(PolylineFormat::Vtp),
-        "csv" => Ok(PolylineFormat::Csv),
-        _ => Err(format!(
-            "{}: ifs writes points and polylines; use .vtp or .csv",
-            path.display()
-        )),
-    }
-}
-
 /// `surface ifs`: the attractor as polylines.
 fn run_ifs(a: &Args) -> super::CliResult {
-    let format = polyline_format(&a.output)?;
+    PolylineFormat::of(&a.output).map_err(|e| e.to_string())?;
     let kind = match a.kind {
         Some(IfsKindArg::CubicBspline) => IfsKind::CubicBSpline,
         Some(IfsKindArg::FourPoint) => IfsKind::FourPoint,
@@ -238,11 +215,7 @@ fn run_ifs(a: &Args) -> super::CliResult {
         None => (gasket_control().to_vec(), "--kind gasket".to_string()),
     };
     let lines = ifs_attractor(kind, &control, a.steps).map_err(|e| format!("{source}: {e}"))?;
-    match format {
-        PolylineFormat::Vtp => write_polylines_vtp(&a.output, &lines),
-        PolylineFormat::Csv => write_polylines_csv(&a.output, &lines),
-    }
-    .map_err(|e| e.to_string())?;
+    write_polylines(&a.output, &lines).map_err(|e| e.to_string())?;
     eprintln!(
         "wrote {}: {} polylines, {} points",
         a.output.display(),

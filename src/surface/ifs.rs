@@ -539,6 +539,38 @@ pub fn ifs_attractor(
     }
 }
 
+/// File formats for points and polylines.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PolylineFormat {
+    /// VTK XML PolyData `.vtp` (ASCII), for ParaView.
+    Vtp,
+    /// Comma-separated values `.csv`.
+    Csv,
+}
+
+impl PolylineFormat {
+    /// The format of `path` from its extension.
+    pub fn of(path: &Path) -> Result<PolylineFormat, IoError> {
+        match super::io::lowercase_extension(path).as_str() {
+            "vtp" => Ok(PolylineFormat::Vtp),
+            "csv" => Ok(PolylineFormat::Csv),
+            _ => Err(IoError::file(
+                path,
+                "points and polylines are written as .vtp or .csv",
+            )),
+        }
+    }
+}
+
+/// Write polylines in the format of the extension of `path`
+/// ([`write_polylines_vtp`] or [`write_polylines_csv`]).
+pub fn write_polylines(path: &Path, polylines: &[Vec<DVec3>]) -> Result<(), IoError> {
+    match PolylineFormat::of(path)? {
+        PolylineFormat::Vtp => write_polylines_vtp(path, polylines),
+        PolylineFormat::Csv => write_polylines_csv(path, polylines),
+    }
+}
+
 /// Write points as CSV (`x,y,z` header, one point a line).
 pub fn write_points_csv(path: &Path, points: &[DVec3]) -> Result<(), IoError> {
     write_atomic(path, |w| {

@@ -46,12 +46,7 @@ pub enum SurfaceFormat {
 impl SurfaceFormat {
     /// The format of `path` from its extension.
     pub fn of(path: &Path) -> Result<SurfaceFormat, IoError> {
-        let ext = path
-            .extension()
-            .and_then(|e| e.to_str())
-            .unwrap_or("")
-            .to_ascii_lowercase();
-        match ext.as_str() {
+        match lowercase_extension(path).as_str() {
             "obj" => Ok(SurfaceFormat::Obj),
             "off" => Ok(SurfaceFormat::Off),
             "ply" => Ok(SurfaceFormat::Ply),
@@ -123,6 +118,14 @@ pub fn write_surface(path: &Path, mesh: &PolyMesh) -> Result<(), IoError> {
 pub(crate) fn read_text(path: &Path) -> Result<String, IoError> {
     let bytes = crate::io::read_bytes(path)?;
     crate::io::as_text(path, &bytes).map(str::to_owned)
+}
+
+/// The extension of `path` in lower case (empty when there is none).
+pub(crate) fn lowercase_extension(path: &Path) -> String {
+    path.extension()
+        .and_then(|e| e.to_str())
+        .unwrap_or("")
+        .to_ascii_lowercase()
 }
 
 /// Parses a finite coordinate, with an error at `line`.
