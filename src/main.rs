@@ -23,8 +23,9 @@ enum Command {
     Refine(cli::refine::Args),
     /// Improve a mesh (edge removal and smoothing), boundary fixed.
     Improve(cli::improve::Args),
-    /// Subdivide a polygon surface (√3, Loop, Catmull–Clark, Doo–Sabin, weighted Catmull–Clark).
-    Surface(cli::surface::Args),
+    /// Subdivide a polygon surface (√3, Loop, Catmull–Clark, Doo–Sabin, weighted Catmull–Clark,
+    /// Sierpinski, vertex truncation) or draw a subdivision IFS attractor.
+    Surface(Box<cli::surface::Args>),
     /// Mesh the volume a closed surface encloses, with TetGen (opt-in feature `tetgen`).
     Mesh(cli::mesh::Args),
 }
@@ -36,7 +37,7 @@ fn main() -> ExitCode {
         Command::Convert(a) => cli::convert::run(a),
         Command::Refine(a) => cli::refine::run(a),
         Command::Improve(a) => cli::improve::run(a),
-        Command::Surface(a) => cli::surface::run(a),
+        Command::Surface(a) => cli::surface::run(*a),
         Command::Mesh(a) => cli::mesh::run(a),
     };
     match result {

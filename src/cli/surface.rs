@@ -4,9 +4,16 @@ use std::path::PathBuf;
 use tetrefine::surface::catmull_clark::catmull_clark;
 use tetrefine::surface::catmull_clark_weighted::{catmull_clark_weighted, WeightedConfig};
 use tetrefine::surface::doo_sabin::doo_sabin;
+use tetrefine::surface::ifs::{
+    gasket_control, ifs_attractor, koch_control, write_polylines, PolylineFormat,
+};
 use tetrefine::surface::loop_scheme::loop_subdivide;
+use tetrefine::surface::sierpinski::{sierpinski_with, SierpinskiOptions};
 use tetrefine::surface::sqrt3::{sqrt3, FaceSelection, Sqrt3Options, Sqrt3Rule};
-use tetrefine::surface::{load_surface, write_surface, Features, PolyMesh, SurfaceFormat};
+use tetrefine::surface::truncate::{check_cut, truncate_with};
+use tetrefine::surface::{
+    load_surface, read_surface, write_surface, Features, IfsKind, PolyMesh, SurfaceFormat,
+};
 
 /// The surface schemes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -25,8 +32,27 @@ pub enum Scheme {
     DooSabin,
     /// Hansmeyer's weighted and extruded Catmull–Clark; weights from --weights FILE.json.
     CatmullClarkWeighted,
-    // Sierpinski, Truncate and Ifs are wired here by the lead after merging
-    // the other surface branch (see the match in `run`).
+    /// Sierpinski polyhedra (closed surfaces; joints as tiny tubes, see --neck).
+    Sierpinski,
+    /// Chaikin vertex truncation, every edge cut at --cut and 1 − cut (closed surfaces).
+    Truncate,
+    /// Attractor of the IFS of a subdivision scheme (--kind); writes polylines (.vtp, .csv).
+    Ifs,
+}
+
+/// The subdivision schemes whose IFS `ifs` iterates.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum IfsKindArg {
+    /// Uniform cubic B-spline curve (at least 4 control points).
+    CubicBspline,
+    /// Interpolating four-point curve (at least 6 control points).
+    FourPoint,
+    /// Bicubic B-spline patch (a --grid NU,NV of control points, row-major).
+    Bicubic,
+    /// Koch curve (5 control points; the standard ones without input).
+    Koch,
+    /// Sierpinski gasket (6 control points; the standard ones without input).
+    Gasket,
 }
 
 /// Arguments of `surface`.
@@ -35,13 +61,14 @@ pub struct Args {
     /// Subdivision scheme.
     #[arg(value_enum)]
     pub scheme: Scheme,
-    /// Input surface (.obj, .off, .ply).
-    pub input: PathBuf,
-    /// Output surface (.obj, .off, .ply, .vtp, .vtk).
+    /// Input surface (.obj, .off, .ply); for ifs, its points are the control
+    /// points (optional for --kind koch and gasket).
+    pub input: Option<PathBuf>,
+    /// Output surface (.obj, .off, .ply, .vtp, .vtk); for ifs, polylines (.vtp, .csv).
     #[arg(short, long)]
     pub output: PathBuf,
-    /// Number of subdivision steps.
-    #[arg(long, default_value_t = 1)]
+    /// Number of subdivision steps (for ifs: rounds of the maps).
+    #[arg(long, visible_alias = "iterations", default_value_t = 1)]
     pub steps: usize,
     /// Tag every edge whose faces meet at more than DEG degrees (normal
     /// deviation) as a crease.
@@ -74,6 +101,20 @@ pub struct Args {
     /// catmull-clark-weighted only: the weights as a JSON file (see the README).
     #[arg(long, value_name = "FILE.json")]
     pub weights: Option<PathBuf>,
+    /// sierpinski only: where the tube at a joint leaves each piece, as a
+    /// fraction of the piece edges (0 < F < 0.5) [default: 0.05].
+    #[arg(long, value_name = "F")]
+    pub neck: Option<f64>,
+    /// truncate only: cut every edge at F and 1 − F of its length (0 < F < 0.5)
+    /// [default: 0.25, Chaikin].
+    #[arg(long, value_name = "F")]
+    pub cut: Option<f64>,
+    /// ifs only: the subdivision scheme.
+    #[arg(long, value_enum)]
+    pub kind: Option<IfsKindArg>,
+    /// ifs --kind bicubic only: the control grid size, "NU,NV".
+    #[arg(long, value_delimiter = ',', value_name = "NU,NV")]
+    pub grid: Option<Vec<usize>>,
 }
 
 /// Faces above which a run is refused rather than exhausting memory.
@@ -91,8 +132,114 @@ fn parse_crease(s: &str) -> Result<[u32; 2], String> {
     Ok([parse(a)?, parse(b)?])
 }
 
+/// Checks that every option given belongs to the scheme, before any work.
+fn check_options(a: &Args, features: &Features) -> Result<(), String> {
+    let only = |given: bool, option: &str, scheme: Scheme, name: &str| {
+        if given && a.scheme != scheme {
+            Err(format!("{option} is for {name}"))
+        } else {
+            Ok(())
+        }
+    };
+    only(
+        a.weights.is_some(),
+        "--weights",
+        Scheme::CatmullClarkWeighted,
+        "catmull-clark-weighted",
+    )?;
+    only(a.neck.is_some(), "--neck", Scheme::Sierpinski, "sierpinski")?;
+    only(a.cut.is_some(), "--cut", Scheme::Truncate, "truncate")?;
+    only(a.kind.is_some(), "--kind", Scheme::Ifs, "ifs")?;
+    if a.grid.is_some() && a.kind != Some(IfsKindArg::Bicubic) {
+        return Err("--grid is for ifs --kind bicubic".into());
+    }
+    if matches!(
+        a.scheme,
+        Scheme::Sierpinski | Scheme::Truncate | Scheme::Ifs
+    ) && *features != Features::default()
+    {
+        return Err("sierpinski, truncate and ifs do not support creases or corners".into());
+    }
+    if a.scheme == Scheme::DooSabin && *features != Features::default() {
+        return Err("doo-sabin does not support creases or corners".into());
+    }
+    if let Some(neck) = a.neck {
+        SierpinskiOptions { neck }
+            .check()
+            .map_err(|e| format!("--neck: {e}"))?;
+    }
+    if let Some(cut) = a.cut {
+        check_cut(cut).map_err(|e| format!("--cut: {e}"))?;
+    }
+    if a.scheme == Scheme::Ifs {
+        if a.kind.is_none() {
+            return Err(
+                "ifs needs --kind cubic-bspline, four-point, bicubic, koch or gasket".into(),
+            );
+        }
+        if a.kind == Some(IfsKindArg::Bicubic) && !a.grid.as_ref().is_some_and(|g| g.len() == 2) {
+            return Err("ifs --kind bicubic needs --grid NU,NV (the control grid size)".into());
+        }
+        if a.input.is_none() && !matches!(a.kind, Some(IfsKindArg::Koch) | Some(IfsKindArg::Gasket))
+        {
+            return Err("ifs needs an input file with the control points (optional only for --kind koch and gasket)".into());
+        }
+    } else if a.input.is_none() {
+        return Err("give the input surface (.obj, .off or .ply)".into());
+    }
+    Ok(())
+}
+
+/// `surface ifs`: the attractor as polylines.
+fn run_ifs(a: &Args) -> super::CliResult {
+    PolylineFormat::of(&a.output).map_err(|e| e.to_string())?;
+    let kind = match a.kind {
+        Some(IfsKindArg::CubicBspline) => IfsKind::CubicBSpline,
+        Some(IfsKindArg::FourPoint) => IfsKind::FourPoint,
+        Some(IfsKindArg::Bicubic) => {
+            let g = a.grid.as_deref().unwrap_or(&[]);
+            IfsKind::Bicubic {
+                nu: g.first().copied().unwrap_or(0),
+                nv: g.get(1).copied().unwrap_or(0),
+            }
+        }
+        Some(IfsKindArg::Koch) => IfsKind::Koch,
+        Some(IfsKindArg::Gasket) | None => IfsKind::Gasket,
+    };
+    let (control, source) = match &a.input {
+        Some(path) => {
+            let file = read_surface(path).map_err(|e| e.to_string())?;
+            (file.mesh.points, path.display().to_string())
+        }
+        None if kind == IfsKind::Koch => (koch_control().to_vec(), "--kind koch".to_string()),
+        None => (gasket_control().to_vec(), "--kind gasket".to_string()),
+    };
+    let lines = ifs_attractor(kind, &control, a.steps).map_err(|e| format!("{source}: {e}"))?;
+    write_polylines(&a.output, &lines).map_err(|e| e.to_string())?;
+    eprintln!(
+        "wrote {}: {} polylines, {} points",
+        a.output.display(),
+        lines.len(),
+        lines.iter().map(Vec::len).sum::<usize>()
+    );
+    Ok(())
+}
+
 /// Runs `surface`.
 pub fn run(a: Args) -> super::CliResult {
+    let features = Features {
+        creases: a
+            .crease
+            .iter()
+            .map(|s| parse_crease(s))
+            .collect::<Result<_, _>>()?,
+        corners: a.corner.clone(),
+        crease_angle: a.crease_angle,
+    };
+    check_options(&a, &features)?;
+    if a.scheme == Scheme::Ifs {
+        return run_ifs(&a);
+    }
     SurfaceFormat::of(&a.output).map_err(|e| e.to_string())?;
     let is_sqrt3 = matches!(
         a.scheme,
@@ -110,27 +257,17 @@ pub fn run(a: Args) -> super::CliResult {
     if a.select_sphere.as_ref().is_some_and(|b| b.len() != 4) {
         return Err("--select-sphere needs four numbers: x,y,z,radius".into());
     }
-    if a.weights.is_some() && a.scheme != Scheme::CatmullClarkWeighted {
-        return Err("--weights is for catmull-clark-weighted".into());
-    }
-    let features = Features {
-        creases: a
-            .crease
-            .iter()
-            .map(|s| parse_crease(s))
-            .collect::<Result<_, _>>()?,
-        corners: a.corner.clone(),
-        crease_angle: a.crease_angle,
-    };
-    if a.scheme == Scheme::DooSabin && features != Features::default() {
-        return Err("doo-sabin does not support creases or corners".into());
-    }
     let weights = match &a.weights {
         Some(p) => Some(WeightedConfig::from_json_file(p).map_err(|e| e.to_string())?),
         None => None,
     };
-    let mesh = load_surface(&a.input).map_err(|e| e.to_string())?;
-    let growth: f64 = if is_sqrt3 { 3.0 } else { 4.0 };
+    let input = a.input.clone().unwrap_or_default();
+    let mesh = load_surface(&input).map_err(|e| e.to_string())?;
+    let growth: f64 = if is_sqrt3 || a.scheme == Scheme::Truncate {
+        3.0
+    } else {
+        4.0
+    };
     let sides: usize = mesh.faces.iter().map(|f| f.len()).sum();
     let predicted = sides as f64 * growth.powi(a.steps.saturating_sub(1).min(64) as i32);
     if predicted > MAX_FACES {
@@ -139,9 +276,8 @@ pub fn run(a: Args) -> super::CliResult {
             a.steps
         ));
     }
-    let ctx = |e: tetrefine::surface::SubdivisionError| format!("{}: {e}", a.input.display());
-    // One arm per scheme; Sierpinski, Truncate and Ifs get their arms here
-    // when the other surface branch is merged.
+    let ctx = |e: tetrefine::surface::SubdivisionError| format!("{}: {e}", input.display());
+    let ctx2 = |e: tetrefine::surface::SurfaceError| format!("{}: {e}", input.display());
     let out: PolyMesh = match a.scheme {
         Scheme::Sqrt3 | Scheme::Sqrt3Interp | Scheme::Sqrt3Linear => {
             let rule = match a.scheme {
@@ -175,6 +311,15 @@ pub fn run(a: Args) -> super::CliResult {
             let cfg = weights.unwrap_or_default();
             catmull_clark_weighted(&mesh, a.steps, &cfg, &features).map_err(ctx)?
         }
+        Scheme::Sierpinski => {
+            let mut opts = SierpinskiOptions::default();
+            if let Some(neck) = a.neck {
+                opts.neck = neck;
+            }
+            sierpinski_with(&mesh, a.steps, &opts).map_err(ctx2)?
+        }
+        Scheme::Truncate => truncate_with(&mesh, a.steps, a.cut.unwrap_or(0.25)).map_err(ctx2)?,
+        Scheme::Ifs => return run_ifs(&a),
     };
     write_surface(&a.output, &out).map_err(|e| e.to_string())?;
     eprintln!(

@@ -17,6 +17,7 @@ pub mod tetgen;
 mod text;
 pub mod vtk;
 
+pub(crate) use text::as_text;
 pub use text::Tokens;
 
 use crate::mesh::{MeshData, TetMesh};

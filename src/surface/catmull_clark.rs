@@ -20,7 +20,7 @@
 //! old vertices keep their ids, then one edge point per edge (in the order of
 //! [`HalfEdges::edges`]), then one face point per face.
 
-use super::features::{classify, sorted_pair, Features, Role, SubdivisionError};
+use super::features::{classify, run_steps, sorted_pair, Features, Role, SubdivisionError};
 use super::polymesh::{HalfEdges, PolyMesh};
 use glam::DVec3;
 use rayon::prelude::*;
@@ -33,21 +33,13 @@ pub fn catmull_clark(
     features: &Features,
 ) -> Result<PolyMesh, SubdivisionError> {
     let he = mesh.half_edges()?;
-    let (mut creases, corners) = features.resolve(mesh, &he)?;
-    let mut cur = mesh.clone();
-    let mut he = Some(he);
-    for _ in 0..steps {
-        let h = match he.take() {
-            Some(h) => h,
-            None => cur.half_edges()?,
-        };
-        let (curve, roles) = classify(&h, &creases, &corners);
-        let points = catmull_clark_points(&cur, &h, &curve, &roles);
-        let faces = catmull_clark_faces(&cur, &h);
-        creases = split_creases(&cur, &h, &creases);
-        cur = PolyMesh { points, faces };
-    }
-    Ok(cur)
+    let (creases, corners) = features.resolve(mesh, &he)?;
+    run_steps(mesh, he, creases, steps, |_, cur, he, creases| {
+        let (curve, roles) = classify(he, creases, &corners);
+        let points = catmull_clark_points(cur, he, &curve, &roles);
+        let faces = catmull_clark_faces(cur, he);
+        (PolyMesh { points, faces }, split_creases(cur, he, creases))
+    })
 }
 
 /// Face points: the averages of the faces' vertices (summed in face order).
@@ -95,14 +87,29 @@ fn catmull_clark_points(
                 let (fbar, rbar, n) = vertex_averages(mesh, he, &fp, v as u32);
                 (fbar + rbar * 2.0 + p[v] * (n - 3.0)) / n
             }
-            Role::Crease([a, b]) => (p[v] * 6.0 + p[a as usize] + p[b as usize]) / 8.0,
+            Role::Crease(curve_nbrs) => crease_vertex_point(p, v, curve_nbrs),
             Role::Corner | Role::Unused => p[v],
         })
         .collect();
-    let mut out = vertex_pts;
-    out.extend_from_slice(&edge_pts);
-    out.extend_from_slice(&fp);
-    out
+    in_point_order(vertex_pts, &edge_pts, &fp)
+}
+
+/// The cubic B-spline vertex rule on a crease or boundary curve,
+/// `(6 p_v + p_a + p_b) / 8` for the curve neighbours `a`, `b` of `v`.
+pub(crate) fn crease_vertex_point(p: &[DVec3], v: usize, [a, b]: [u32; 2]) -> DVec3 {
+    (p[v] * 6.0 + p[a as usize] + p[b as usize]) / 8.0
+}
+
+/// The new points in the numbering of [`catmull_clark_faces`]: vertex
+/// points, then edge points, then face points.
+pub(crate) fn in_point_order(
+    mut vertex_pts: Vec<DVec3>,
+    edge_pts: &[DVec3],
+    face_pts: &[DVec3],
+) -> Vec<DVec3> {
+    vertex_pts.extend_from_slice(edge_pts);
+    vertex_pts.extend_from_slice(face_pts);
+    vertex_pts
 }
 
 /// For a smooth vertex: the average of its face points, the average of the

@@ -61,8 +61,10 @@
 //! halves stay locked for the rest of those iterations, so the original edge
 //! stays exactly where it was.
 
-use super::catmull_clark::{catmull_clark_faces, split_creases};
-use super::features::{classify, sorted_pair, Features, Role, SubdivisionError};
+use super::catmull_clark::{
+    catmull_clark_faces, crease_vertex_point, in_point_order, split_creases,
+};
+use super::features::{classify, run_steps, sorted_pair, Features, Role, SubdivisionError};
 use super::polymesh::{HalfEdges, PolyMesh, NO_TWIN};
 use crate::io::IoError;
 use glam::DVec3;
@@ -230,8 +232,8 @@ pub struct WeightedConfig {
 impl WeightedConfig {
     /// Reads a configuration from a JSON file; errors name the file and line.
     pub fn from_json_file(path: &Path) -> Result<WeightedConfig, IoError> {
-        let text = super::io::read_text(path)?;
-        serde_json::from_str(&text).map_err(|e| IoError {
+        let bytes = crate::io::read_bytes(path)?;
+        serde_json::from_slice(&bytes).map_err(|e| IoError {
             path: path.to_path_buf(),
             line: Some(e.line()).filter(|&l| l > 0),
             message: format!("invalid weights file: {e}"),
@@ -317,7 +319,7 @@ pub fn catmull_clark_weighted(
     features: &Features,
 ) -> Result<PolyMesh, SubdivisionError> {
     let he0 = mesh.half_edges()?;
-    let (mut creases, corners) = features.resolve(mesh, &he0)?;
+    let (creases, corners) = features.resolve(mesh, &he0)?;
     // Validate the configuration against the input.
     let edge_set: HashSet<[u32; 2]> = he0.edges.iter().copied().collect();
     let mut vertex_group: HashMap<u32, usize> = HashMap::new();
@@ -383,16 +385,10 @@ pub fn catmull_clark_weighted(
         }
     }
     let spatial = Spatial { cfg, scale };
-    let mut cur = mesh.clone();
     let mut origin = vec![Origin::Input; mesh.points.len()];
-    let mut he = Some(he0);
-    for it in 0..steps {
-        let h = match he.take() {
-            Some(h) => h,
-            None => cur.half_edges()?,
-        };
+    run_steps(mesh, he0, creases, steps, |it, cur, h, creases| {
         let base = cfg.iteration_weights(it);
-        let (curve, roles) = classify(&h, &creases, &corners);
+        let (curve, roles) = classify(h, creases, &corners);
         let vertex_locked: Vec<bool> = (0..cur.points.len())
             .map(|v| {
                 vertex_group
@@ -401,8 +397,8 @@ pub fn catmull_clark_weighted(
             })
             .collect();
         let ctx = StepContext {
-            mesh: &cur,
-            he: &h,
+            mesh: cur,
+            he: h,
             curve: &curve,
             roles: &roles,
             origin: &origin,
@@ -416,7 +412,7 @@ pub fn catmull_clark_weighted(
             first: it == 0,
         };
         let points = ctx.points();
-        let faces = catmull_clark_faces(&cur, &h);
+        let faces = catmull_clark_faces(cur, h);
         // Bookkeeping for the next iteration.
         let nv = cur.points.len();
         let ne = h.edges.len();
@@ -437,13 +433,11 @@ pub fn catmull_clark_weighted(
                 }
             }
         }
-        creases = split_creases(&cur, &h, &creases);
-        cur = PolyMesh { points, faces };
         origin = next_origin;
         face_group = next_group;
         locked = next_locked;
-    }
-    Ok(cur)
+        (PolyMesh { points, faces }, split_creases(cur, h, creases))
+    })
 }
 
 struct StepContext<'a> {
@@ -606,14 +600,11 @@ impl StepContext<'_> {
                             / n
                             + nrm * w.vertex_extrude
                     }
-                    Role::Crease([a, b]) => (p[v] * 6.0 + p[a as usize] + p[b as usize]) / 8.0,
+                    Role::Crease(curve_nbrs) => crease_vertex_point(p, v, curve_nbrs),
                     Role::Corner | Role::Unused => p[v],
                 }
             })
             .collect();
-        let mut out = vertex_pts;
-        out.extend_from_slice(&edge_pts);
-        out.extend_from_slice(&fp);
-        out
+        in_point_order(vertex_pts, &edge_pts, &fp)
     }
 }

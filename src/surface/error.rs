@@ -1,5 +1,6 @@
 //! [`SurfaceError`]: why a surface scheme refused its input.
 
+use super::polymesh::TopologyError;
 use thiserror::Error;
 
 /// Why a surface scheme (Sierpinski, truncation, IFS) refused its input.
@@ -40,11 +41,11 @@ pub enum SurfaceError {
         /// The vertex.
         vertex: usize,
     },
-    /// Two faces use the same directed edge: the edge is shared by more than
-    /// two faces, or its two faces are not consistently oriented.
+    /// Two faces use the same directed edge: they are not consistently
+    /// oriented.
     #[error(
         "edge {from}->{to} is used in the same direction by faces {first} and {second}: \
-         the faces are not consistently oriented or the edge is non-manifold"
+         the faces are not consistently oriented"
     )]
     EdgeOrientation {
         /// Start vertex of the edge.
@@ -55,6 +56,14 @@ pub enum SurfaceError {
         first: usize,
         /// The second face using it.
         second: usize,
+    },
+    /// An edge is shared by more than two faces.
+    #[error("edge {}-{} is shared by {faces} faces (a manifold edge has at most 2)", edge[0], edge[1])]
+    NonManifoldEdge {
+        /// The edge (sorted vertex ids).
+        edge: [u32; 2],
+        /// How many face sides use it.
+        faces: usize,
     },
     /// An edge lies in one face only: the surface has a boundary.
     #[error("edge {from}-{to} lies in face {face} only: the surface has a boundary, and this scheme needs a closed surface")]
@@ -89,4 +98,39 @@ pub enum SurfaceError {
     /// A parameter is out of its range.
     #[error("{0}")]
     Parameter(String),
+}
+
+impl From<TopologyError> for SurfaceError {
+    /// The same finding, in the terms of this error type.
+    fn from(e: TopologyError) -> Self {
+        match e {
+            TopologyError::FaceTooSmall { face, len } => SurfaceError::FaceTooSmall { face, len },
+            TopologyError::IndexOutOfRange {
+                face,
+                index,
+                points,
+            } => SurfaceError::VertexOutOfRange {
+                face,
+                vertex: index,
+                count: points,
+            },
+            TopologyError::RepeatedVertex { face, vertex } => {
+                SurfaceError::RepeatedVertex { face, vertex }
+            }
+            TopologyError::NonManifoldEdge { edge, faces } => {
+                SurfaceError::NonManifoldEdge { edge, faces }
+            }
+            TopologyError::InconsistentOrientation { edge, faces } => {
+                SurfaceError::EdgeOrientation {
+                    from: edge[0],
+                    to: edge[1],
+                    first: faces[0],
+                    second: faces[1],
+                }
+            }
+            TopologyError::NonManifoldVertex { vertex, .. } => {
+                SurfaceError::NonManifoldVertex { vertex }
+            }
+        }
+    }
 }

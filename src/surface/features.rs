@@ -202,3 +202,32 @@ pub(crate) fn classify(
         .collect();
     (curve, roles)
 }
+
+/// Runs `steps` steps of a scheme with tagged creases from `mesh`, whose
+/// adjacency `he` was built when the input was validated: step `k` gets the
+/// current mesh, its adjacency (`he` for the first step, rebuilt for every
+/// later mesh) and its crease set, and returns the refined mesh and the
+/// refined crease set.
+pub(crate) fn run_steps(
+    mesh: &PolyMesh,
+    he: HalfEdges,
+    mut creases: HashSet<[u32; 2]>,
+    steps: usize,
+    mut step: impl FnMut(
+        usize,
+        &PolyMesh,
+        &HalfEdges,
+        &HashSet<[u32; 2]>,
+    ) -> (PolyMesh, HashSet<[u32; 2]>),
+) -> Result<PolyMesh, SubdivisionError> {
+    let mut cur = mesh.clone();
+    let mut first = Some(he);
+    for k in 0..steps {
+        let he = match first.take() {
+            Some(he) => he,
+            None => cur.half_edges()?,
+        };
+        (cur, creases) = step(k, &cur, &he, &creases);
+    }
+    Ok(cur)
+}

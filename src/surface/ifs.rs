@@ -54,6 +54,7 @@
 //!   Sierpinski gasket.
 
 use super::error::SurfaceError;
+use super::vtp;
 use crate::io::{write_atomic, IoError};
 use glam::DVec3;
 use std::io::Write;
@@ -538,6 +539,38 @@ pub fn ifs_attractor(
     }
 }
 
+/// File formats for points and polylines.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PolylineFormat {
+    /// VTK XML PolyData `.vtp` (ASCII), for ParaView.
+    Vtp,
+    /// Comma-separated values `.csv`.
+    Csv,
+}
+
+impl PolylineFormat {
+    /// The format of `path` from its extension.
+    pub fn of(path: &Path) -> Result<PolylineFormat, IoError> {
+        match super::io::lowercase_extension(path).as_str() {
+            "vtp" => Ok(PolylineFormat::Vtp),
+            "csv" => Ok(PolylineFormat::Csv),
+            _ => Err(IoError::file(
+                path,
+                "points and polylines are written as .vtp or .csv",
+            )),
+        }
+    }
+}
+
+/// Write polylines in the format of the extension of `path`
+/// ([`write_polylines_vtp`] or [`write_polylines_csv`]).
+pub fn write_polylines(path: &Path, polylines: &[Vec<DVec3>]) -> Result<(), IoError> {
+    match PolylineFormat::of(path)? {
+        PolylineFormat::Vtp => write_polylines_vtp(path, polylines),
+        PolylineFormat::Csv => write_polylines_csv(path, polylines),
+    }
+}
+
 /// Write points as CSV (`x,y,z` header, one point a line).
 pub fn write_points_csv(path: &Path, points: &[DVec3]) -> Result<(), IoError> {
     write_atomic(path, |w| {
@@ -564,8 +597,12 @@ pub fn write_polylines_csv(path: &Path, polylines: &[Vec<DVec3>]) -> Result<(), 
 
 /// Write points as VTK XML PolyData (`.vtp`, ASCII), one vertex cell each.
 pub fn write_points_vtp(path: &Path, points: &[DVec3]) -> Result<(), IoError> {
-    let lines: Vec<Vec<DVec3>> = points.iter().map(|&p| vec![p]).collect();
-    write_polylines_vtp(path, &lines)
+    write_atomic(path, |w| {
+        vtp::write_header(w, points.len(), [points.len(), 0, 0])?;
+        vtp::write_points(w, points.iter())?;
+        vtp::write_cells(w, "Verts", (0..points.len() as u64).map(std::iter::once))?;
+        vtp::write_footer(w)
+    })
 }
 
 /// Write polylines as VTK XML PolyData (`.vtp`, ASCII) for ParaView:
@@ -573,72 +610,26 @@ pub fn write_points_vtp(path: &Path, points: &[DVec3]) -> Result<(), IoError> {
 /// `Verts` cells. Every polyline has its own points.
 pub fn write_polylines_vtp(path: &Path, polylines: &[Vec<DVec3>]) -> Result<(), IoError> {
     let total: usize = polylines.iter().map(Vec::len).sum();
-    // (first point id, polyline) of the single points and of the lines.
-    type Cells<'a> = Vec<(usize, &'a Vec<DVec3>)>;
-    let (verts, lines): (Cells, Cells) = {
-        let mut first = 0;
-        let mut all = Vec::new();
-        for l in polylines {
-            all.push((first, l));
-            first += l.len();
-        }
-        all.into_iter()
-            .filter(|(_, l)| !l.is_empty())
-            .partition(|(_, l)| l.len() == 1)
+    // Point ids of each polyline: consecutive, in polyline order.
+    let mut first = Vec::with_capacity(polylines.len());
+    let mut next = 0u64;
+    for l in polylines {
+        first.push(next);
+        next += l.len() as u64;
+    }
+    let cells = |single: bool| {
+        polylines
+            .iter()
+            .zip(&first)
+            .filter(move |(l, _)| !l.is_empty() && (l.len() == 1) == single)
+            .map(|(l, &f)| f..f + l.len() as u64)
     };
     write_atomic(path, |w| {
-        writeln!(w, r#"<?xml version="1.0"?>"#)?;
-        writeln!(
-            w,
-            r#"<VTKFile type="PolyData" version="1.0" byte_order="LittleEndian" header_type="UInt64">"#
-        )?;
-        writeln!(w, "  <PolyData>")?;
-        writeln!(
-            w,
-            r#"    <Piece NumberOfPoints="{total}" NumberOfVerts="{}" NumberOfLines="{}" NumberOfStrips="0" NumberOfPolys="0">"#,
-            verts.len(),
-            lines.len()
-        )?;
-        writeln!(w, "      <Points>")?;
-        writeln!(
-            w,
-            r#"        <DataArray type="Float64" Name="Points" NumberOfComponents="3" format="ascii">"#
-        )?;
-        for p in polylines.iter().flatten() {
-            writeln!(w, "          {} {} {}", p.x, p.y, p.z)?;
-        }
-        writeln!(w, "        </DataArray>")?;
-        writeln!(w, "      </Points>")?;
-        for (tag, cells) in [("Verts", &verts), ("Lines", &lines)] {
-            if cells.is_empty() {
-                continue;
-            }
-            writeln!(w, "      <{tag}>")?;
-            writeln!(
-                w,
-                r#"        <DataArray type="Int64" Name="connectivity" format="ascii">"#
-            )?;
-            for (first, l) in cells.iter() {
-                let ids: Vec<String> = (*first..first + l.len()).map(|i| i.to_string()).collect();
-                writeln!(w, "          {}", ids.join(" "))?;
-            }
-            writeln!(w, "        </DataArray>")?;
-            writeln!(
-                w,
-                r#"        <DataArray type="Int64" Name="offsets" format="ascii">"#
-            )?;
-            let mut end = 0;
-            for (_, l) in cells.iter() {
-                end += l.len();
-                writeln!(w, "          {end}")?;
-            }
-            writeln!(w, "        </DataArray>")?;
-            writeln!(w, "      </{tag}>")?;
-        }
-        writeln!(w, "    </Piece>")?;
-        writeln!(w, "  </PolyData>")?;
-        writeln!(w, "</VTKFile>")?;
-        Ok(())
+        vtp::write_header(w, total, [cells(true).count(), cells(false).count(), 0])?;
+        vtp::write_points(w, polylines.iter().flatten())?;
+        vtp::write_cells(w, "Verts", cells(true))?;
+        vtp::write_cells(w, "Lines", cells(false))?;
+        vtp::write_footer(w)
     })
 }
 

@@ -15,6 +15,8 @@
 
 use super::polymesh::PolyMesh;
 use crate::io::IoError;
+use glam::DVec3;
+use std::io::Write;
 use std::path::Path;
 
 /// A mesh as read from a file, with the 1-based line of each face.
@@ -44,12 +46,7 @@ pub enum SurfaceFormat {
 impl SurfaceFormat {
     /// The format of `path` from its extension.
     pub fn of(path: &Path) -> Result<SurfaceFormat, IoError> {
-        let ext = path
-            .extension()
-            .and_then(|e| e.to_str())
-            .unwrap_or("")
-            .to_ascii_lowercase();
-        match ext.as_str() {
+        match lowercase_extension(path).as_str() {
             "obj" => Ok(SurfaceFormat::Obj),
             "off" => Ok(SurfaceFormat::Off),
             "ply" => Ok(SurfaceFormat::Ply),
@@ -116,27 +113,19 @@ pub fn write_surface(path: &Path, mesh: &PolyMesh) -> Result<(), IoError> {
     }
 }
 
-/// The file as UTF-8 text, or an error naming the first bad line.
+/// The file as UTF-8 text, or an error naming the file (and the first bad
+/// line).
 pub(crate) fn read_text(path: &Path) -> Result<String, IoError> {
-    let bytes = std::fs::read(path).map_err(|e| {
-        IoError::file(
-            path,
-            match e.kind() {
-                std::io::ErrorKind::NotFound => "no such file".to_string(),
-                std::io::ErrorKind::PermissionDenied => "permission denied".to_string(),
-                _ => e.to_string(),
-            },
-        )
-    })?;
-    String::from_utf8(bytes).map_err(|e| {
-        let valid = e.utf8_error().valid_up_to();
-        let line = e.as_bytes()[..valid]
-            .iter()
-            .filter(|&&c| c == b'\n')
-            .count()
-            + 1;
-        IoError::at(path, line, "not a text file (invalid UTF-8)")
-    })
+    let bytes = crate::io::read_bytes(path)?;
+    crate::io::as_text(path, &bytes).map(str::to_owned)
+}
+
+/// The extension of `path` in lower case (empty when there is none).
+pub(crate) fn lowercase_extension(path: &Path) -> String {
+    path.extension()
+        .and_then(|e| e.to_str())
+        .unwrap_or("")
+        .to_ascii_lowercase()
 }
 
 /// Parses a finite coordinate, with an error at `line`.
@@ -224,6 +213,28 @@ pub(crate) fn check_face(
                 format!("face visits vertex {} twice", v + base),
             ));
         }
+    }
+    Ok(())
+}
+
+/// Writes one `x y z` line per point (shortest round-trip decimals), the
+/// vertex block of `.off`, `.ply` and legacy `.vtk`.
+pub(crate) fn write_xyz_lines(w: &mut impl Write, points: &[DVec3]) -> std::io::Result<()> {
+    for p in points {
+        writeln!(w, "{} {} {}", p.x, p.y, p.z)?;
+    }
+    Ok(())
+}
+
+/// Writes one line per face: its vertex count, then its 0-based vertex ids,
+/// the face block of `.off`, `.ply` and legacy `.vtk`.
+pub(crate) fn write_counted_faces(w: &mut impl Write, faces: &[Vec<u32>]) -> std::io::Result<()> {
+    for f in faces {
+        write!(w, "{}", f.len())?;
+        for &v in f {
+            write!(w, " {v}")?;
+        }
+        writeln!(w)?;
     }
     Ok(())
 }

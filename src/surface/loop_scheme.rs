@@ -17,7 +17,7 @@
 //!
 //! Counts per step: V' = V + E, E' = 2E + 3F, F' = 4F.
 
-use super::features::{classify, sorted_pair, Features, Role, SubdivisionError};
+use super::features::{classify, run_steps, sorted_pair, Features, Role, SubdivisionError};
 use super::polymesh::{HalfEdges, PolyMesh, NO_TWIN};
 use glam::DVec3;
 use rayon::prelude::*;
@@ -48,19 +48,10 @@ pub fn loop_subdivide(
         });
     }
     let he = mesh.half_edges()?;
-    let (mut creases, corners) = features.resolve(mesh, &he)?;
-    let mut cur = mesh.clone();
-    let mut he = Some(he);
-    for _ in 0..steps {
-        let h = match he.take() {
-            Some(h) => h,
-            None => cur.half_edges()?,
-        };
-        let (next, next_creases) = loop_step(&cur, &h, &creases, &corners);
-        cur = next;
-        creases = next_creases;
-    }
-    Ok(cur)
+    let (creases, corners) = features.resolve(mesh, &he)?;
+    run_steps(mesh, he, creases, steps, |_, cur, he, creases| {
+        loop_step(cur, he, creases, &corners)
+    })
 }
 
 /// One Loop step; returns the refined mesh and its crease set.

@@ -9,8 +9,8 @@
 //!   [`catmull_clark`], [`doo_sabin`], [`catmull_clark_weighted`]
 //!   (Hansmeyer's weighted and extruded Catmull–Clark), all with tagged
 //!   creases and corners through [`features`];
-//! * the seed papers' other constructions: [`sierpinski`] (Sierpinski
-//!   polyhedra), [`truncate`] (Chaikin vertex truncation) and [`ifs`]
+//! * the seed papers' other constructions: [`mod@sierpinski`] (Sierpinski
+//!   polyhedra), [`mod@truncate`] (Chaikin vertex truncation) and [`ifs`]
 //!   (subdivision as iterated function systems).
 
 pub mod catmull_clark;

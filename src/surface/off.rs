@@ -6,7 +6,10 @@
 //! `k i0 … i(k−1)` with 0-based ids; anything after the ids (a colour) is
 //! ignored. `#` starts a comment. Written: `OFF`, counts, vertices and faces.
 
-use super::io::{check_face, parse_coord, parse_int, read_text, short, SurfaceFile};
+use super::io::{
+    check_face, parse_coord, parse_int, read_text, short, write_counted_faces, write_xyz_lines,
+    SurfaceFile,
+};
 use super::polymesh::PolyMesh;
 use crate::io::{write_atomic, IoError};
 use glam::DVec3;
@@ -112,16 +115,8 @@ pub fn write(path: &Path, mesh: &PolyMesh) -> Result<(), IoError> {
     write_atomic(path, |w| {
         writeln!(w, "OFF")?;
         writeln!(w, "{} {} {}", mesh.points.len(), mesh.faces.len(), ne)?;
-        for p in &mesh.points {
-            writeln!(w, "{} {} {}", p.x, p.y, p.z)?;
-        }
-        for f in &mesh.faces {
-            write!(w, "{}", f.len())?;
-            for &v in f {
-                write!(w, " {v}")?;
-            }
-            writeln!(w)?;
-        }
+        write_xyz_lines(w, &mesh.points)?;
+        write_counted_faces(w, &mesh.faces)?;
         Ok(())
     })
 }

@@ -7,7 +7,9 @@
 //! coordinates, `uchar`/`int` face lists (`int` counts if a face has more
 //! than 255 vertices).
 
-use super::io::{check_face, parse_coord, read_text, short, SurfaceFile};
+use super::io::{
+    check_face, parse_coord, read_text, short, write_counted_faces, write_xyz_lines, SurfaceFile,
+};
 use super::polymesh::PolyMesh;
 use crate::io::{write_atomic, IoError};
 use glam::DVec3;
@@ -265,16 +267,8 @@ pub fn write(path: &Path, mesh: &PolyMesh) -> Result<(), IoError> {
         writeln!(w, "element face {}", mesh.faces.len())?;
         writeln!(w, "property list {count_type} int vertex_indices")?;
         writeln!(w, "end_header")?;
-        for p in &mesh.points {
-            writeln!(w, "{} {} {}", p.x, p.y, p.z)?;
-        }
-        for f in &mesh.faces {
-            write!(w, "{}", f.len())?;
-            for &v in f {
-                write!(w, " {v}")?;
-            }
-            writeln!(w)?;
-        }
+        write_xyz_lines(w, &mesh.points)?;
+        write_counted_faces(w, &mesh.faces)?;
         Ok(())
     })
 }

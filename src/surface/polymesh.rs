@@ -551,9 +551,9 @@ impl PolyMesh {
         used.iter().filter(|&&u| u).count()
     }
 
-    /// Undirected edges (sorted vertex pairs) of the faces, without
-    /// validation, sorted.
-    pub fn edge_list(&self) -> Vec<[u32; 2]> {
+    /// The side of every face as a sorted vertex pair, all of them sorted
+    /// (an edge appears once per face that uses it), without validation.
+    fn sorted_face_sides(&self) -> Vec<[u32; 2]> {
         let mut e: Vec<[u32; 2]> = self
             .faces
             .iter()
@@ -565,36 +565,24 @@ impl PolyMesh {
             })
             .collect();
         e.par_sort_unstable();
+        e
+    }
+
+    /// Undirected edges (sorted vertex pairs) of the faces, without
+    /// validation, sorted.
+    pub fn edge_list(&self) -> Vec<[u32; 2]> {
+        let mut e = self.sorted_face_sides();
         e.dedup();
         e
     }
 
     /// Edges used by exactly one face (sorted pairs), without validation.
     pub fn boundary_edges(&self) -> Vec<[u32; 2]> {
-        let mut e: Vec<[u32; 2]> = self
-            .faces
-            .iter()
-            .flat_map(|f| {
-                (0..f.len()).map(move |k| {
-                    let (a, b) = (f[k], f[(k + 1) % f.len()]);
-                    [a.min(b), a.max(b)]
-                })
-            })
-            .collect();
-        e.par_sort_unstable();
-        let mut out = Vec::new();
-        let mut i = 0;
-        while i < e.len() {
-            let mut j = i + 1;
-            while j < e.len() && e[j] == e[i] {
-                j += 1;
-            }
-            if j - i == 1 {
-                out.push(e[i]);
-            }
-            i = j;
-        }
-        out
+        self.sorted_face_sides()
+            .chunk_by(|a, b| a == b)
+            .filter(|run| run.len() == 1)
+            .map(|run| run[0])
+            .collect()
     }
 
     /// Euler characteristic V − E + F, counting only points used by faces.

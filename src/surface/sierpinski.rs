@@ -62,9 +62,9 @@
 //! quadruples, `g_(k+1) − g_k = 2E·4^(k−1)`, and
 //! `g_(k+1) = 4g_k + 3(V − 1) − E`, so `g_(k+1)/g_k → 4`.
 
-use super::closed_manifold::ClosedManifold;
+use super::closed_manifold::closed_half_edges;
 use super::error::SurfaceError;
-use super::PolyMesh;
+use super::polymesh::{HalfEdges, PolyMesh, NO_TWIN};
 
 /// Options of [`sierpinski_with`].
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -79,6 +79,20 @@ impl Default for SierpinskiOptions {
     /// `neck = 0.05`.
     fn default() -> Self {
         SierpinskiOptions { neck: 0.05 }
+    }
+}
+
+impl SierpinskiOptions {
+    /// Checks the options: the neck lies strictly between 0 and 0.5.
+    pub fn check(&self) -> Result<(), SurfaceError> {
+        let neck = self.neck;
+        if neck > 0.0 && neck < 0.5 {
+            Ok(())
+        } else {
+            Err(SurfaceError::Parameter(format!(
+                "the Sierpinski neck must lie strictly between 0 and 0.5, got {neck}"
+            )))
+        }
     }
 }
 
@@ -99,21 +113,15 @@ pub fn sierpinski_with(
     steps: usize,
     options: &SierpinskiOptions,
 ) -> Result<PolyMesh, SurfaceError> {
+    options.check()?;
     let neck = options.neck;
-    if !(neck > 0.0 && neck < 0.5) {
-        return Err(SurfaceError::Parameter(format!(
-            "the Sierpinski neck must lie strictly between 0 and 0.5, got {neck}"
-        )));
-    }
-    let adj = ClosedManifold::new(mesh)?;
+    let he = closed_half_edges(mesh)?;
     if steps == 0 {
         return Ok(mesh.clone());
     }
     // Guard against counts that overflow 32-bit ids: V_k from the module docs.
-    let e = adj.edge_count() as f64;
-    let v = (0..mesh.points.len() as u32)
-        .filter(|&v| adj.is_used(v))
-        .count() as f64;
+    let e = he.edges.len() as f64;
+    let v = he.vertex_out.iter().filter(|&&h| h != NO_TWIN).count() as f64;
     let q = 4f64.powi(steps.min(64) as i32 - 1);
     let estimate = 2.0 * e * q + (v + 2.0 * e * (q - 1.0) / 3.0) + 4.0 * e * (4.0 * q - 1.0) / 3.0;
     if estimate > i32::MAX as f64 {
@@ -123,7 +131,7 @@ pub fn sierpinski_with(
             what: "vertices",
         });
     }
-    let mut pieces = first_step(mesh, &adj);
+    let mut pieces = pyramids(mesh, &he, &[]);
     for _ in 1..steps {
         pieces = pieces.step()?;
     }
@@ -139,20 +147,25 @@ struct Pieces {
 
 const NONE: u32 = u32::MAX;
 
-fn first_step(mesh: &PolyMesh, adj: &ClosedManifold) -> Pieces {
-    pyramids(mesh, adj, &[])
+/// The outgoing half-edges of `v` in clockwise order (the reverse of
+/// [`HalfEdges::outgoing`]): consecutive entries `v -> u`, `v -> w` lie in the
+/// one face in which `u` precedes and `w` follows `v`.
+fn clockwise(he: &HalfEdges, v: u32) -> Vec<u32> {
+    let mut ring = he.outgoing(v);
+    ring.reverse();
+    ring
 }
 
 impl Pieces {
     fn step(&self) -> Result<Pieces, SurfaceError> {
-        let adj = ClosedManifold::new(&self.mesh)?;
-        Ok(pyramids(&self.mesh, &adj, &self.joints))
+        let he = closed_half_edges(&self.mesh)?;
+        Ok(pyramids(&self.mesh, &he, &self.joints))
     }
 
     /// The manifold: every joint becomes a tube of three quadrilaterals
     /// between two triangular holes cut at `neck` along the joint's edges.
     fn with_tubes(&self, neck: f64) -> Result<PolyMesh, SurfaceError> {
-        let adj = ClosedManifold::new(&self.mesh)?;
+        let he = closed_half_edges(&self.mesh)?;
         let p = &self.mesh.points;
         let nv = p.len();
         let mut is_joint = vec![false; nv];
@@ -163,16 +176,16 @@ impl Pieces {
         let mut points = Vec::new();
         let mut new_id = vec![NONE; nv];
         // Truncation vertex on each half-edge leaving a joint vertex.
-        let mut cut = vec![NONE; adj.half_edge_count()];
+        let mut cut = vec![NONE; he.len()];
         for v in 0..nv as u32 {
-            if !adj.is_used(v) {
+            if he.vertex_out[v as usize] == NO_TWIN {
                 continue;
             }
             if is_joint[v as usize] {
                 let a = p[v as usize];
-                for h in adj.ring(v) {
+                for h in he.outgoing(v) {
                     cut[h as usize] = points.len() as u32;
-                    points.push(a + neck * (p[adj.to(h) as usize] - a));
+                    points.push(a + neck * (p[he.dest(h) as usize] - a));
                 }
             } else {
                 new_id[v as usize] = points.len() as u32;
@@ -183,12 +196,11 @@ impl Pieces {
         for (f, face) in self.mesh.faces.iter().enumerate() {
             let n = face.len();
             let mut out = Vec::with_capacity(2 * n);
-            for (i, &v) in face.iter().enumerate() {
+            for (h, &v) in (he.face_start[f]..).zip(face) {
                 if is_joint[v as usize] {
                     // u -> v -> w becomes u -> cut(v->u) -> cut(v->w) -> w.
-                    let incoming = adj.half_edge(f, (i + n - 1) % n);
-                    out.push(cut[adj.twin(incoming) as usize]);
-                    out.push(cut[adj.half_edge(f, i) as usize]);
+                    out.push(cut[he.twin[he.prev(h) as usize] as usize]);
+                    out.push(cut[h as usize]);
                 } else {
                     out.push(new_id[v as usize]);
                 }
@@ -197,8 +209,8 @@ impl Pieces {
         }
         for &[a, b] in &self.joints {
             // Rings: the face of ring[j + 1] holds cut(ring[j]) -> cut(ring[j + 1]).
-            let ta: Vec<u32> = adj.ring(a).iter().map(|&h| cut[h as usize]).collect();
-            let tb: Vec<u32> = adj.ring(b).iter().map(|&h| cut[h as usize]).collect();
+            let ta: Vec<u32> = clockwise(&he, a).iter().map(|&h| cut[h as usize]).collect();
+            let tb: Vec<u32> = clockwise(&he, b).iter().map(|&h| cut[h as usize]).collect();
             let d = ta.len();
             if tb.len() != d {
                 return Err(SurfaceError::Parameter(format!(
@@ -234,22 +246,22 @@ impl Pieces {
 /// One step: a pyramid per used vertex (apex copy, its own midpoint copies,
 /// corner triangles, back face), a joint per edge, and the old joints moved
 /// to the apex copies.
-fn pyramids(mesh: &PolyMesh, adj: &ClosedManifold, old_joints: &[[u32; 2]]) -> Pieces {
+fn pyramids(mesh: &PolyMesh, he: &HalfEdges, old_joints: &[[u32; 2]]) -> Pieces {
     let p = &mesh.points;
     let mut points = Vec::new();
     let mut apex = vec![NONE; p.len()];
-    let mut mid = vec![NONE; adj.half_edge_count()];
+    let mut mid = vec![NONE; he.len()];
     let mut faces = Vec::new();
     for v in 0..p.len() as u32 {
-        if !adj.is_used(v) {
+        if he.vertex_out[v as usize] == NO_TWIN {
             continue;
         }
-        let ring = adj.ring(v);
+        let ring = clockwise(he, v);
         apex[v as usize] = points.len() as u32;
         points.push(p[v as usize]);
         for &h in &ring {
             mid[h as usize] = points.len() as u32;
-            points.push(0.5 * (p[v as usize] + p[adj.to(h) as usize]));
+            points.push(0.5 * (p[v as usize] + p[he.dest(h) as usize]));
         }
         // ring[j] = v -> u and ring[j + 1] = v -> w lie in the face u -> v -> w:
         // its corner triangle is (mid(v,u), v, mid(v,w)).
@@ -268,8 +280,7 @@ fn pyramids(mesh: &PolyMesh, adj: &ClosedManifold, old_joints: &[[u32; 2]]) -> P
         .iter()
         .map(|&[a, b]| [apex[a as usize], apex[b as usize]])
         .collect();
-    for h in 0..adj.half_edge_count() as u32 {
-        let t = adj.twin(h);
+    for (h, &t) in (0..).zip(&he.twin) {
         if h < t {
             joints.push([mid[h as usize], mid[t as usize]]);
         }

@@ -21,9 +21,9 @@
 //! and the face of a 3-valent vertex is a triangle; after the first step all
 //! vertices are 3-valent, so this holds at every step.
 
-use super::closed_manifold::ClosedManifold;
+use super::closed_manifold::closed_half_edges;
 use super::error::SurfaceError;
-use super::PolyMesh;
+use super::polymesh::{HalfEdges, PolyMesh};
 
 /// `steps` steps of Chaikin vertex truncation (cut at 1/4 and 3/4 of every
 /// edge) of a closed, consistently oriented manifold polygon mesh.
@@ -34,16 +34,23 @@ pub fn truncate(mesh: &PolyMesh, steps: usize) -> Result<PolyMesh, SurfaceError>
     truncate_with(mesh, steps, 0.25)
 }
 
+/// Checks a truncation cut: it lies strictly between 0 and 0.5.
+pub fn check_cut(cut: f64) -> Result<(), SurfaceError> {
+    if cut > 0.0 && cut < 0.5 {
+        Ok(())
+    } else {
+        Err(SurfaceError::Parameter(format!(
+            "the truncation cut must lie strictly between 0 and 0.5, got {cut}"
+        )))
+    }
+}
+
 /// Vertex truncation that cuts every edge at `cut` and `1 − cut` of its length
 /// (`0 < cut < 0.5`; Chaikin's rule, and [`truncate`], is `cut = 0.25`).
 pub fn truncate_with(mesh: &PolyMesh, steps: usize, cut: f64) -> Result<PolyMesh, SurfaceError> {
-    if !(cut > 0.0 && cut < 0.5) {
-        return Err(SurfaceError::Parameter(format!(
-            "the truncation cut must lie strictly between 0 and 0.5, got {cut}"
-        )));
-    }
-    let adj = ClosedManifold::new(mesh)?;
-    let estimate = 2.0 * adj.edge_count() as f64 * 3f64.powi(steps.min(64) as i32);
+    check_cut(cut)?;
+    let he = closed_half_edges(mesh)?;
+    let estimate = he.len() as f64 * 3f64.powi(steps.min(64) as i32);
     if estimate > i32::MAX as f64 {
         return Err(SurfaceError::TooLarge {
             steps,
@@ -54,40 +61,40 @@ pub fn truncate_with(mesh: &PolyMesh, steps: usize, cut: f64) -> Result<PolyMesh
     if steps == 0 {
         return Ok(mesh.clone());
     }
-    let mut current = truncate_once(mesh, &adj, cut);
+    let mut current = truncate_once(mesh, &he, cut);
     for _ in 1..steps {
-        let adj = ClosedManifold::new(&current)?;
-        current = truncate_once(&current, &adj, cut);
+        let he = closed_half_edges(&current)?;
+        current = truncate_once(&current, &he, cut);
     }
     Ok(current)
 }
 
-fn truncate_once(mesh: &PolyMesh, adj: &ClosedManifold, cut: f64) -> PolyMesh {
+fn truncate_once(mesh: &PolyMesh, he: &HalfEdges, cut: f64) -> PolyMesh {
     let p = &mesh.points;
-    // One new vertex per half-edge v -> w, at v + cut (w - v).
-    let points = (0..adj.half_edge_count() as u32)
+    // One new vertex per half-edge v -> w, at v + cut (w - v); its id is the
+    // half-edge id.
+    let points = (0..he.len() as u32)
         .map(|h| {
-            let a = p[adj.from(h) as usize];
-            a + cut * (p[adj.to(h) as usize] - a)
+            let a = p[he.origin[h as usize] as usize];
+            a + cut * (p[he.dest(h) as usize] - a)
         })
         .collect();
     let mut faces = Vec::with_capacity(mesh.faces.len() + p.len());
-    for (f, face) in mesh.faces.iter().enumerate() {
-        let n = face.len();
-        let mut out = Vec::with_capacity(2 * n);
-        for i in 0..n {
-            // u -> v -> w becomes cut(v->u) -> cut(v->w).
-            out.push(adj.twin(adj.half_edge(f, (i + n - 1) % n)));
-            out.push(adj.half_edge(f, i));
-        }
-        faces.push(out);
+    for f in 0..mesh.faces.len() {
+        let (start, end) = (he.face_start[f], he.face_start[f + 1]);
+        // u -> v -> w becomes cut(v->u) -> cut(v->w).
+        faces.push(
+            (start..end)
+                .flat_map(|h| [he.twin[he.prev(h) as usize], h])
+                .collect(),
+        );
     }
     for v in 0..p.len() as u32 {
-        if adj.is_used(v) {
-            // The face of ring[j + 1] holds cut(ring[j]) -> cut(ring[j + 1]);
-            // the vertex face runs the other way.
-            let mut ring = adj.ring(v);
-            ring.reverse();
+        // Around v, counter-clockwise: the face of outgoing[j] holds
+        // cut(outgoing[j + 1]) -> cut(outgoing[j]), so the vertex face, which
+        // runs the other way along that side, is the outgoing list itself.
+        let ring = he.outgoing(v);
+        if !ring.is_empty() {
             faces.push(ring);
         }
     }
@@ -192,6 +199,17 @@ mod tests {
         );
     }
 
+    /// The largest distance of a face's vertex to the face's best-fit plane.
+    fn worst_plane_deviation(mesh: &PolyMesh) -> f64 {
+        mesh.faces
+            .iter()
+            .map(|f| {
+                let pts: Vec<DVec3> = f.iter().map(|&i| mesh.points[i as usize]).collect();
+                plane_deviation(&pts)
+            })
+            .fold(0.0, f64::max)
+    }
+
     #[test]
     fn planar_faces_with_3_valent_vertices_stay_planar() {
         let mut inputs = vec![
@@ -215,15 +233,7 @@ mod tests {
                 );
             }
             for k in 1..=4 {
-                let out = truncate(&mesh, k).expect("ok");
-                let worst = out
-                    .faces
-                    .iter()
-                    .map(|f| {
-                        let pts: Vec<DVec3> = f.iter().map(|&i| out.points[i as usize]).collect();
-                        plane_deviation(&pts)
-                    })
-                    .fold(0.0, f64::max);
+                let worst = worst_plane_deviation(&truncate(&mesh, k).expect("ok"));
                 assert!(
                     worst < 1e-12,
                     "{name}, {k} steps: face off its plane by {worst}"
@@ -236,15 +246,7 @@ mod tests {
     fn non_3_valent_vertices_give_non_planar_faces() {
         // The counter-case the paper describes: the icosphere's 5- and
         // 6-valent vertices are not coplanar with their quarter points.
-        let out = truncate(&icosphere(1), 1).expect("ok");
-        let worst = out
-            .faces
-            .iter()
-            .map(|f| {
-                let pts: Vec<DVec3> = f.iter().map(|&i| out.points[i as usize]).collect();
-                plane_deviation(&pts)
-            })
-            .fold(0.0, f64::max);
+        let worst = worst_plane_deviation(&truncate(&icosphere(1), 1).expect("ok"));
         assert!(worst > 1e-4, "{worst}");
     }
 

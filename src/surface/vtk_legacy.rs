@@ -1,6 +1,7 @@
 //! Legacy VTK `.vtk` POLYDATA, ASCII, file version 3.0 (`POLYGONS` with
 //! per-face counts), readable by every ParaView and VTK release.
 
+use super::io::{write_counted_faces, write_xyz_lines};
 use super::polymesh::PolyMesh;
 use crate::io::{write_atomic, IoError};
 use std::io::Write;
@@ -15,17 +16,9 @@ pub fn write(path: &Path, mesh: &PolyMesh) -> Result<(), IoError> {
         writeln!(w, "ASCII")?;
         writeln!(w, "DATASET POLYDATA")?;
         writeln!(w, "POINTS {} double", mesh.points.len())?;
-        for p in &mesh.points {
-            writeln!(w, "{} {} {}", p.x, p.y, p.z)?;
-        }
+        write_xyz_lines(w, &mesh.points)?;
         writeln!(w, "POLYGONS {} {}", mesh.faces.len(), size)?;
-        for f in &mesh.faces {
-            write!(w, "{}", f.len())?;
-            for &v in f {
-                write!(w, " {v}")?;
-            }
-            writeln!(w)?;
-        }
+        write_counted_faces(w, &mesh.faces)?;
         Ok(())
     })
 }
