@@ -11,7 +11,11 @@ use tetrefine::MeshStats;
 #[test]
 fn tripod_beats_table_1_in_every_boundary_mode() {
     let paper = [(6.1, 36.1), (4.9, 28.4)];
-    for rule in [BoundaryRule::Interpolating, BoundaryRule::Approximating, BoundaryRule::Linear] {
+    for rule in [
+        BoundaryRule::Interpolating,
+        BoundaryRule::Approximating,
+        BoundaryRule::Linear,
+    ] {
         let (mut mesh, _) = load_mesh(Path::new("meshes/tripod.mesh")).unwrap();
         let opts = RefineOptions {
             boundary: rule,
@@ -27,7 +31,11 @@ fn tripod_beats_table_1_in_every_boundary_mode() {
                 s.min_dihedral_deg.avg,
                 s.tets
             );
-            assert!(s.min_dihedral_deg.worst > worst, "{rule:?} step {}", step + 1);
+            assert!(
+                s.min_dihedral_deg.worst > worst,
+                "{rule:?} step {}",
+                step + 1
+            );
             assert!(s.min_dihedral_deg.avg > avg, "{rule:?} step {}", step + 1);
             // Beyond the paper: the average stays above 38° (the input has 42.92°).
             assert!(s.min_dihedral_deg.avg > 38.0, "{rule:?} step {}", step + 1);
@@ -47,7 +55,11 @@ fn tripod_linear_and_approximating_keep_the_inputs_worst_angle() {
         for step in 1..=2 {
             refine_step(&mut mesh, step, &opts);
             let s = MeshStats::compute(&mesh);
-            assert!(s.min_dihedral_deg.worst >= 7.56, "{rule:?} step {step}: {}", s.min_dihedral_deg.worst);
+            assert!(
+                s.min_dihedral_deg.worst >= 7.56,
+                "{rule:?} step {step}: {}",
+                s.min_dihedral_deg.worst
+            );
         }
     }
 }
@@ -73,13 +85,25 @@ fn improve_never_lowers_the_worst_and_raises_the_average() {
         let after = MeshStats::compute(&mesh);
         eprintln!(
             "{name}: worst {:.2} -> {:.2}, avg {:.2} -> {:.2}",
-            before.min_dihedral_deg.worst, after.min_dihedral_deg.worst, before.min_dihedral_deg.avg, after.min_dihedral_deg.avg
+            before.min_dihedral_deg.worst,
+            after.min_dihedral_deg.worst,
+            before.min_dihedral_deg.avg,
+            after.min_dihedral_deg.avg
         );
-        assert!(after.min_dihedral_deg.worst >= before.min_dihedral_deg.worst, "{name}");
-        assert!(after.min_dihedral_deg.avg > before.min_dihedral_deg.avg, "{name}");
+        assert!(
+            after.min_dihedral_deg.worst >= before.min_dihedral_deg.worst,
+            "{name}"
+        );
+        assert!(
+            after.min_dihedral_deg.avg > before.min_dihedral_deg.avg,
+            "{name}"
+        );
         // The boundary is fixed: same boundary faces, same volume.
         assert_eq!(after.boundary_faces, before.boundary_faces, "{name}");
-        assert!((after.volume - before.volume).abs() <= 1e-9 * before.volume.abs(), "{name}");
+        assert!(
+            (after.volume - before.volume).abs() <= 1e-9 * before.volume.abs(),
+            "{name}"
+        );
         if before.min_dihedral_deg.worst < 15.0 {
             below_15 += 1;
             if after.min_dihedral_deg.worst > before.min_dihedral_deg.worst {
@@ -91,5 +115,8 @@ fn improve_never_lowers_the_worst_and_raises_the_average() {
         }
     }
     assert!(below_15 > 0);
-    assert!(2 * raised_below_15 > below_15, "{raised_below_15} of {below_15}");
+    assert!(
+        2 * raised_below_15 > below_15,
+        "{raised_below_15} of {below_15}"
+    );
 }

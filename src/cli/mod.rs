@@ -78,3 +78,39 @@ pub fn write_refined(path: &Path, mesh: &mut TetMesh, extra: Vec<CellArray>) -> 
         tetrefine::io::write_mesh(path, mesh).map_err(|e| e.to_string())
     }
 }
+
+/// Applies `--features auto|none|FILE` to a freshly loaded mesh and tells the
+/// user on stderr what it found.
+pub fn apply_feature_option(mesh: &mut TetMesh, spec: &str, angle_deg: f64) -> CliResult {
+    use tetrefine::refine::features::{detect_features, read_edge_list};
+    match spec {
+        "none" => mesh.clear_features(),
+        "auto" => {
+            let r = detect_features(mesh, angle_deg);
+            eprintln!(
+                "features: {} edges ({} by angle > {angle_deg}°, {} between patches, {} at junctions, the rest from the input), {} corners",
+                r.feature_edges, r.by_angle, r.by_patch, r.by_junction, r.corners
+            );
+        }
+        file => {
+            let n = read_edge_list(mesh, Path::new(file)).map_err(|e| e.to_string())?;
+            eprintln!(
+                "features: {n} edges from {file}; {} feature edges and {} corners in all",
+                mesh.feature_edges().len(),
+                mesh.corners().len()
+            );
+        }
+    }
+    Ok(())
+}
+
+/// Writes the feature edges of `mesh` as two-point polylines (.vtp or .csv).
+pub fn write_feature_lines(path: &Path, mesh: &TetMesh) -> CliResult {
+    let mut edges: Vec<[u32; 2]> = mesh.feature_edges().keys().copied().collect();
+    edges.sort_unstable();
+    let lines: Vec<Vec<glam::DVec3>> = edges
+        .iter()
+        .map(|e| vec![mesh.point(e[0]), mesh.point(e[1])])
+        .collect();
+    tetrefine::surface::ifs::write_polylines(path, &lines).map_err(|e| e.to_string())
+}

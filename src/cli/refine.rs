@@ -46,6 +46,18 @@ pub struct Args {
     /// Write the final min-dihedral histogram (.csv, .svg or .png).
     #[arg(long)]
     pub histogram: Option<PathBuf>,
+    /// Sharp features: `auto` (input tags plus detected creases, patch borders
+    /// and interface junctions), `none`, or an edge-list file (`v0 v1` per
+    /// line, 0-based) added to the input tags.
+    #[arg(long, default_value = "auto")]
+    pub features: String,
+    /// Normal deviation (degrees) above which a boundary edge is a crease
+    /// (with `--features auto`; MMG's ridge angle is 45°).
+    #[arg(long, default_value_t = 45.0)]
+    pub feature_angle: f64,
+    /// Write the output feature edges as polylines (.vtp for ParaView, or .csv).
+    #[arg(long)]
+    pub features_out: Option<PathBuf>,
 }
 
 /// Runs `refine`.
@@ -60,7 +72,17 @@ pub fn run(a: Args) -> super::CliResult {
             a.threshold
         ));
     }
-    let input = super::load(&a.input)?;
+    if !(a.feature_angle > 0.0 && a.feature_angle < 180.0) {
+        return Err(format!(
+            "--feature-angle {} must lie in (0, 180) degrees",
+            a.feature_angle
+        ));
+    }
+    if let Some(f) = &a.features_out {
+        tetrefine::surface::ifs::PolylineFormat::of(f).map_err(|e| e.to_string())?;
+    }
+    let mut input = super::load(&a.input)?;
+    super::apply_feature_option(&mut input, &a.features, a.feature_angle)?;
     let mut mesh = input.clone();
     let opts = RefineOptions {
         boundary: a.boundary,
@@ -96,6 +118,9 @@ pub fn run(a: Args) -> super::CliResult {
             .map_err(|e| e.to_string())?;
     }
     super::write_refined(&a.output, &mut mesh, Vec::new())?;
+    if let Some(f) = &a.features_out {
+        super::write_feature_lines(f, &mesh)?;
+    }
     if let Some(h) = &a.histogram {
         let last = &steps.last().expect("input entry").stats;
         super::write_histogram(h, last)?;

@@ -346,6 +346,12 @@ impl TetMesh {
         }
     }
 
+    /// Removes every feature edge and corner tag.
+    pub fn clear_features(&mut self) {
+        self.feature_edges.clear();
+        self.corners.clear();
+    }
+
     /// Corner vertices.
     pub fn corners(&self) -> &HashSet<u32> {
         &self.corners

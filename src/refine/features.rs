@@ -8,7 +8,11 @@
 //! * its two faces belong to different patches (different boundary markers or
 //!   different region pairs);
 //! * the normals of its two faces differ by more than the feature angle (45° by
-//!   default, MMG's ridge angle).
+//!   default, MMG's ridge angle);
+//! * it lies on a material interface whose two faces there are not coplanar.
+//!   A √3 flip of such an edge would cut a chord through one region into the
+//!   other, so curved interfaces are refined by the crease rule instead and
+//!   every region stays exactly what it was.
 //!
 //! Corners are the vertices with other than two incident feature edges (and
 //! at least one), plus those tagged in the input. Tags read from the input
@@ -74,6 +78,8 @@ pub struct FeatureReport {
     pub by_patch: usize,
     /// Edges added because other than two constrained faces meet there.
     pub by_junction: usize,
+    /// Edges added because they bend a material interface.
+    pub curved_interface: usize,
 }
 
 /// Tags feature edges (with marker 0 when new) and corners on `mesh` by the
@@ -116,6 +122,8 @@ pub fn detect_features(mesh: &mut TetMesh, angle_deg: f64) -> FeatureReport {
             // Consistently oriented neighbours: the normal deviation is the
             // angle between the normals.
             Some(&mut report.by_angle)
+        } else if sides[0].patch.0 != i64::MIN && !coplanar(mesh, e, sides) {
+            Some(&mut report.curved_interface)
         } else {
             None
         };
@@ -128,6 +136,13 @@ pub fn detect_features(mesh: &mut TetMesh, angle_deg: f64) -> FeatureReport {
     report.feature_edges = mesh.feature_edges().len();
     report.corners = mesh.corners().len();
     report
+}
+
+/// Whether the two faces at interface edge `e` lie in one plane (to a
+/// relative 1e-12 in the cosine of the normals' angle, which only rounding of
+/// exactly coplanar input stays within).
+fn coplanar(_mesh: &TetMesh, _e: [u32; 2], sides: &[SideFace]) -> bool {
+    sides[0].normal.dot(sides[1].normal) >= 1.0 - 1e-12
 }
 
 /// Adds as corners the vertices with other than two incident feature edges.

@@ -28,9 +28,49 @@ pub fn locate_parents(input: &TetMesh, mesh: &mut TetMesh) {
     }
 }
 
-/// Visibility walk from `start` towards `x`; returns the tet containing `x`,
-/// or the last tet before leaving the domain. Bounded by the number of tets.
+/// Whether tet `t` contains `x` (boundary included), by exact predicates.
+pub fn contains(mesh: &TetMesh, t: u32, x: DVec3) -> bool {
+    let v = mesh.tet(t);
+    TET_FACES.iter().all(|l| {
+        orient3d(
+            mesh.point(v[l[0]]),
+            mesh.point(v[l[1]]),
+            mesh.point(v[l[2]]),
+            x,
+        ) <= 0.0
+    })
+}
+
+/// Visibility walk from `start` towards `x`; returns the tet containing `x`.
+/// In a non-convex domain the straight walk can reach the boundary first;
+/// then a breadth-first search over face neighbours from `start` (at most
+/// 100,000 tets) looks for the containing tet. If none is found (the point
+/// is outside the domain), the tet where the walk left the domain.
 pub fn walk_to(mesh: &TetMesh, start: u32, x: DVec3) -> u32 {
+    let end = straight_walk(mesh, start, x);
+    if contains(mesh, end, x) {
+        return end;
+    }
+    let mut seen = std::collections::HashSet::new();
+    let mut queue = std::collections::VecDeque::from([start]);
+    seen.insert(start);
+    while let Some(t) = queue.pop_front() {
+        if contains(mesh, t, x) {
+            return t;
+        }
+        if seen.len() > 100_000 {
+            break;
+        }
+        for h in mesh.adj(t) {
+            if h != NO_ADJ && seen.insert(h >> 2) {
+                queue.push_back(h >> 2);
+            }
+        }
+    }
+    end
+}
+
+fn straight_walk(mesh: &TetMesh, start: u32, x: DVec3) -> u32 {
     let mut cur = start;
     let mut prev = u32::MAX;
     for _ in 0..mesh.n_tet_slots() + 1 {

@@ -8,7 +8,7 @@ use crate::ops::{
     split_interface_face, trisect_edge, EdgeRing,
 };
 use crate::smooth::{ball_stays_positive, improve, ImproveOptions};
-use crate::surface::sqrt3::sqrt3_positions;
+use crate::surface::sqrt3::sqrt3_positions_trisecting;
 use glam::DVec3;
 use std::collections::{HashMap, HashSet};
 use std::time::Instant;
@@ -32,6 +32,11 @@ struct StepState {
     /// 1-based step number: feature edges are kept in odd steps and trisected
     /// in even ones.
     step: usize,
+    /// Feature edges as they were when the step began (the old surface's
+    /// creases, which the √3 stencils must see even after trisection).
+    creases: HashSet<[u32; 2]>,
+    /// Old feature edges trisected in this step.
+    trisected: HashSet<[u32; 2]>,
 }
 
 /// One √3 step. `step` is 1-based (odd and even steps differ on creases).
@@ -54,6 +59,8 @@ pub fn refine_step_with_progress(
         split_faces: Vec::new(),
         split_interfaces: Vec::new(),
         step,
+        creases: mesh.feature_edges().keys().copied().collect(),
+        trisected: HashSet::new(),
     };
     for phase in Phase::ALL {
         let t0 = Instant::now();
@@ -62,7 +69,7 @@ pub fn refine_step_with_progress(
             Phase::Split => split_phase(mesh, opts, &mut report),
             Phase::Flip => flip_phase(mesh, &st, &mut report),
             Phase::BoundarySplit => boundary_split_phase(mesh, &mut st, &mut report),
-            Phase::BoundaryFlip => boundary_flip_phase(mesh, &st, &mut report),
+            Phase::BoundaryFlip => boundary_flip_phase(mesh, &mut st, &mut report),
             Phase::BoundarySmooth => boundary_smooth_phase(mesh, &st, opts, &mut report),
             Phase::Optimize => {
                 // The topological phases appended tets and points at the ends
@@ -339,12 +346,21 @@ fn constrained_ring_vertices(mesh: &TetMesh, ring: &EdgeRing) -> Vec<u32> {
     out
 }
 
+/// Whether `a`, `b`, `m1`, `m2` lie in one plane up to rounding: the volume
+/// of the tet they span is below 1e-10 of the product of its edge lengths
+/// from `a`.
+fn flat_enough(mesh: &TetMesh, a: u32, b: u32, m1: u32, m2: u32) -> bool {
+    let [pa, pb, p1, p2] = [a, b, m1, m2].map(|v| mesh.point(v));
+    let det = crate::geom::orient3d(pa, pb, p1, p2).abs();
+    det <= 1e-10 * (pb - pa).length() * (p1 - pa).length() * (p2 - pa).length()
+}
+
 /// Phase 4: every old boundary or interface edge whose constrained faces were
 /// all split is flipped (boundary: edge removal, m → 2m − 2; interface: the
 /// two-sided removal of [`remove_interface_edge`]), so that the new edge joins
 /// two face points. Feature edges are kept in odd steps and trisected in even
 /// steps (seed paper §5).
-fn boundary_flip_phase(mesh: &mut TetMesh, st: &StepState, report: &mut StepReport) {
+fn boundary_flip_phase(mesh: &mut TetMesh, st: &mut StepState, report: &mut StepReport) {
     let fp = st.first_face_point;
     // Old edges seen from the split faces, with how often and one face point.
     let mut seen: HashMap<[u32; 2], (u32, u8)> =
@@ -386,7 +402,10 @@ fn boundary_flip_phase(mesh: &mut TetMesh, st: &StepState, report: &mut StepRepo
             let (pa, pb) = (mesh.point(a), mesh.point(b));
             let (x1, x2) = (pa + (pb - pa) / 3.0, pa + (pb - pa) * (2.0 / 3.0));
             match trisect_edge(mesh, a, b, &ball, x1, x2) {
-                Ok(_) => report.trisected_feature_edges += 1,
+                Ok(_) => {
+                    report.trisected_feature_edges += 1;
+                    st.trisected.insert([a, b]);
+                }
                 Err(_) => report.refused_boundary_flips += 1,
             }
             continue;
@@ -399,6 +418,12 @@ fn boundary_flip_phase(mesh: &mut TetMesh, st: &StepState, report: &mut StepRepo
             continue;
         }
         let result = if ring.closed {
+            // Only a flat interface may be flipped: across a bend, the new
+            // edge would cut a chord from one region into the other.
+            if !flat_enough(mesh, a, b, cons[0], cons[1]) {
+                report.refused_boundary_flips += 1;
+                continue;
+            }
             remove_interface_edge(mesh, &ring, cons[0], cons[1])
         } else {
             let same_marker =
@@ -429,25 +454,30 @@ fn boundary_smooth_phase(
         return;
     }
     let tris: Vec<[u32; 3]> = st.split_faces.iter().map(|(f, _)| *f).collect();
-    let creases: HashSet<[u32; 2]> = mesh.feature_edges().keys().copied().collect();
+    let creases = &st.creases;
     let corners: HashSet<u32> = mesh
         .corners()
         .iter()
         .chain(mesh.required_vertices())
         .copied()
         .collect();
-    let pos = sqrt3_positions(
+    // The trisected variant places the face points of faces along a
+    // trisected crease as the surface scheme would; the crease points
+    // themselves stay where trisection put them (linear, on the segment).
+    let pos = sqrt3_positions_trisecting(
         mesh.points(),
         &tris,
         opts.boundary.sqrt3_rule(),
-        &creases,
+        creases,
         &corners,
-    );
+        &st.trisected,
+    )
+    .positions;
     // Points that never move here: on a feature edge, corners, required
     // vertices, and every point of an interface (interfaces are refined
     // linearly so that each region stays exactly what it was).
     let mut pinned: HashSet<u32> = corners.clone();
-    for e in &creases {
+    for e in creases.iter().chain(mesh.feature_edges().keys()) {
         pinned.insert(e[0]);
         pinned.insert(e[1]);
     }

@@ -752,7 +752,9 @@ fn pinched_boundary_edges(mesh: &TetMesh) -> Vec<([u32; 2], u32)> {
             if mesh.is_boundary_face(t, f) {
                 let v = mesh.face_vertices(t, f);
                 for i in 0..3 {
-                    *count.entry(crate::mesh::edge_key(v[i], v[(i + 1) % 3])).or_default() += 1;
+                    *count
+                        .entry(crate::mesh::edge_key(v[i], v[(i + 1) % 3]))
+                        .or_default() += 1;
                 }
             }
         }

@@ -26,7 +26,10 @@ pub fn laplacian_smooth(
 ) -> Option<f64> {
     let x = laplacian_target(mesh, v, ball, scratch);
     let (q, mean) = ball_min_mean_at(mesh, v, ball, x);
-    if q > current && mean >= ball_min_mean_at(mesh, v, ball, mesh.point(v)).1 && ball_stays_positive(mesh, v, ball, x) {
+    if q > current
+        && mean >= ball_min_mean_at(mesh, v, ball, mesh.point(v)).1
+        && ball_stays_positive(mesh, v, ball, x)
+    {
         mesh.set_point(v, x);
         Some(q)
     } else {
