@@ -14,6 +14,7 @@
 //!    ([`crate::smooth::improve`]).
 
 pub mod features;
+pub mod marking;
 pub mod parents;
 pub mod step;
 
