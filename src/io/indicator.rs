@@ -125,7 +125,7 @@ pub fn read_indicator(spec: &str, mesh: &TetMesh) -> Result<Vec<f64>, IoError> {
 /// Why `x` is not a valid indicator value, if it is not one.
 fn bad_value(x: f64) -> Option<&'static str> {
     if x.is_nan() {
-        Some("NaN")
+        Some("not a number")
     } else if x.is_infinite() {
         Some("infinite")
     } else if x < 0.0 {
@@ -137,7 +137,7 @@ fn bad_value(x: f64) -> Option<&'static str> {
 
 /// The message for an invalid value of `what` (e.g. "tet 3").
 fn value_message(what: &str, x: f64, why: &str) -> String {
-    format!("the value {x} of {what} is {why}; an indicator must be a finite number >= 0")
+    format!("the value of {what} is {x} ({why}); an indicator must be a finite number >= 0")
 }
 
 /// A number as solvers write it: Rust syntax, or Fortran's `1.5D-3`.
@@ -499,9 +499,15 @@ pub fn read_sol(path: &Path, tets: &[[u32; 4]], n_points: usize) -> Result<Vec<f
                         format!("the value of vertex {} (1-based)", i + 1)
                     };
                     let x: f64 = match tok.next() {
-                        None => return Err(tok.error(format!(
-                            "file ends where {what} was expected (truncated?): {kw} announces {n}"
-                        ))),
+                        None => {
+                            return Err(IoError::at(
+                                path,
+                                last_line(&text),
+                                format!(
+                                    "file ends where {what} was expected (truncated?): {kw} announces {n}, found {i}"
+                                ),
+                            ))
+                        }
                         Some(t) => parse_number(t).ok_or_else(|| {
                             tok.error(format!("expected {what}, found '{}'", shorten(t)))
                         })?,
