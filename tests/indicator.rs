@@ -305,7 +305,15 @@ fn spec_parsing() {
 /// Each bad file (read for the 6-tet, 8-vertex cube), the cell array named
 /// after `FILE.vtu:`, the line its error must name (None: a problem of the
 /// whole file), and words the message must hold.
-const BAD: &[(&str, Option<&str>, Option<usize>, &[&str])] = &[
+/// (file, cell array, line, words).
+type BadCase = (
+    &'static str,
+    Option<&'static str>,
+    Option<usize>,
+    &'static [&'static str],
+);
+
+const BAD: &[BadCase] = &[
     (
         "wrong_count.txt",
         None,

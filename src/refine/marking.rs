@@ -288,7 +288,7 @@ impl fmt::Display for MarkStrategy {
 
 /// The number of tets `fraction:F` selects out of `n`: k = ⌈F·n⌉, where a
 /// product within a relative 1e-9 of an integer counts as that integer (so
-/// 0.3·10, which is 3.0000000000000004 in floating point, gives 3, not 4),
+/// 0.07·100, which is 7.000000000000001 in floating point, gives 7, not 8),
 /// clamped to `1..=n` for n > 0.
 pub fn fraction_count(f: f64, n: usize) -> usize {
     if n == 0 {

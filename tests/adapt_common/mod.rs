@@ -60,8 +60,8 @@ pub fn kuhn_mesh(nx: usize, ny: usize, nz: usize) -> (MeshData, TetMesh) {
 pub fn centroid(d: &MeshData, t: usize) -> [f64; 3] {
     let mut c = [0.0; 3];
     for &v in &d.tets[t] {
-        for a in 0..3 {
-            c[a] += d.points[v as usize][a];
+        for (ca, pa) in c.iter_mut().zip(d.points[v as usize]) {
+            *ca += pa;
         }
     }
     c.map(|x| x / 4.0)
