@@ -70,7 +70,7 @@ fn write_all_formats(dir: &Path, mesh: &TetMesh, values: &[f64]) -> Vec<String> 
         order.swap(i, rng.below(i as u64 + 1) as usize);
     }
     assert_ne!(order, (0..n).collect::<Vec<_>>());
-    let mut csv = String::from("value,tet\n");
+    let mut csv = String::from("\u{feff}value,tet\n"); // with a byte-order mark
     for &t in &order {
         writeln!(csv, "{},{t}", values[t]).unwrap();
     }
@@ -225,6 +225,44 @@ fn vtu_array_is_read_at_the_tetrahedra_only() {
         read_indicator(&format!("{}:count", spec(&p)), &mesh).unwrap(),
         vec![3.0, 7.0]
     );
+}
+
+#[test]
+fn vtu_array_spans_every_piece_in_file_order() {
+    // The same two tets as above, one per piece, the second piece numbering
+    // its points from 0 again.
+    let piece = |pts: &str, val: &str| {
+        format!(
+            r#"    <Piece NumberOfPoints="4" NumberOfCells="1">
+      <Points><DataArray type="Float64" NumberOfComponents="3" format="ascii">{pts}</DataArray></Points>
+      <Cells>
+        <DataArray type="Int32" Name="connectivity" format="ascii">0 1 2 3</DataArray>
+        <DataArray type="Int32" Name="offsets" format="ascii">4</DataArray>
+        <DataArray type="UInt8" Name="types" format="ascii">10</DataArray>
+      </Cells>
+      <CellData><DataArray type="Float64" Name="eta" format="ascii">{val}</DataArray></CellData>
+    </Piece>
+"#
+        )
+    };
+    let vtu = format!(
+        "<VTKFile type=\"UnstructuredGrid\" version=\"1.0\">\n  <UnstructuredGrid>\n{}{}  </UnstructuredGrid>\n</VTKFile>\n",
+        piece("0 0 0 1 0 0 0 1 0 0 0 1", "0.75"),
+        piece("1 0 0 0 1 0 0 0 1 1 1 1", "2.5")
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let p = dir.path().join("pieces.vtu");
+    std::fs::write(&p, vtu).unwrap();
+    let (mesh, _) = tetrefine::io::load_mesh(&p).unwrap();
+    assert_eq!(mesh.n_tets(), 2);
+    // Tet 1 is the one with the point (1,1,1), from the second piece.
+    let far = mesh
+        .tet(1)
+        .iter()
+        .any(|&v| mesh.point(v).to_array() == [1.0, 1.0, 1.0]);
+    assert!(far);
+    let s = format!("{}:eta", spec(&p));
+    assert_eq!(read_indicator(&s, &mesh).unwrap(), vec![0.75, 2.5]);
 }
 
 /// Volume of a tet from its corners, by the triple product.

@@ -156,10 +156,11 @@ fn shorten(s: &str) -> String {
 }
 
 /// The file as text, or an error naming the line of the first byte that
-/// cannot be text (invalid UTF-8 or a NUL byte).
+/// cannot be text (invalid UTF-8 or a NUL byte). A leading byte-order mark
+/// (spreadsheets write one) is dropped.
 fn read_text(path: &Path) -> Result<String, IoError> {
     let bytes = read_bytes(path)?;
-    let binary_at = |valid: usize| {
+    let binary_at = |bytes: &[u8], valid: usize| {
         let line = bytes[..valid].iter().filter(|&&c| c == b'\n').count() + 1;
         IoError::at(
             path,
@@ -168,9 +169,16 @@ fn read_text(path: &Path) -> Result<String, IoError> {
         )
     };
     if let Some(i) = bytes.iter().position(|&c| c == 0) {
-        return Err(binary_at(i));
+        return Err(binary_at(&bytes, i));
     }
-    String::from_utf8(bytes.clone()).map_err(|e| binary_at(e.utf8_error().valid_up_to()))
+    let mut text = String::from_utf8(bytes).map_err(|e| {
+        let valid = e.utf8_error().valid_up_to();
+        binary_at(e.as_bytes(), valid)
+    })?;
+    if text.starts_with('\u{feff}') {
+        text.drain(..'\u{feff}'.len_utf8());
+    }
+    Ok(text)
 }
 
 /// The line to blame when a file ends early: its last line (1 for an empty file).

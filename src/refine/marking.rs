@@ -435,7 +435,8 @@ fn select_live(
 
 /// Applies `strategy` to `mesh` with the indicator `values` (one per live tet
 /// in [`TetMesh::tet_ids`] order, each finite and ≥ 0; needed only by the
-/// value-ranking strategies, see [`MarkStrategy::needs_indicator`]).
+/// value-ranking strategies, see [`MarkStrategy::needs_indicator`], but
+/// checked whenever given).
 ///
 /// Returns one flag per tet **slot** (`mesh.n_tet_slots()` entries, `false`
 /// for dead slots), ready for
