@@ -430,7 +430,17 @@ fn sol_count(tok: &mut Tokens, what: &str, text_len: usize) -> Result<usize, IoE
 pub fn read_sol(path: &Path, tets: &[[u32; 4]], n_points: usize) -> Result<Vec<f64>, IoError> {
     let text = read_text(path)?;
     let mut tok = Tokens::new(path, &text, true);
-    let mut dim = 3usize;
+    const DIM: usize = 3;
+    if let Some((t, &v)) = tets
+        .iter()
+        .enumerate()
+        .find_map(|(t, vs)| vs.iter().find(|&&v| v as usize >= n_points).map(|v| (t, v)))
+    {
+        return Err(IoError::file(
+            path,
+            format!("tet {t} refers to vertex {v} of a mesh with {n_points} vertices"),
+        ));
+    }
     let mut at_tets: Option<Vec<f64>> = None;
     let mut at_vertices: Option<Vec<f64>> = None;
     let mut saw_any = false;
@@ -450,7 +460,6 @@ pub fn read_sol(path: &Path, tets: &[[u32; 4]], n_points: usize) -> Result<Vec<f
                         "Dimension {d}: a solution on a tetrahedral mesh has Dimension 3"
                     )));
                 }
-                dim = 3;
             }
             "Time" => {
                 let _: f64 = tok.parse("a time")?;
@@ -474,7 +483,7 @@ pub fn read_sol(path: &Path, tets: &[[u32; 4]], n_points: usize) -> Result<Vec<f
                 let mut widths = Vec::with_capacity(nsol.min(16));
                 for _ in 0..nsol {
                     let ty: i64 = tok.parse("a solution type (1 scalar, 2 vector, 3 tensor)")?;
-                    let w = sol_width(ty, dim).ok_or_else(|| {
+                    let w = sol_width(ty, DIM).ok_or_else(|| {
                         tok.error(format!(
                             "solution type {ty} is not 1 (scalar), 2 (vector) or 3 (tensor)"
                         ))
