@@ -8,6 +8,7 @@
 
 pub mod gid;
 pub mod gmsh;
+pub mod indicator;
 pub mod medit;
 pub mod off;
 pub mod plc;

@@ -17,6 +17,9 @@
 //! array `valence` (Int32, incident edges); field data `histogram_counts`
 //! (Int64) and `histogram_edges_deg` (Float64): the minimum-dihedral histogram
 //! of [`MeshStats::compute`].
+//!
+//! [`read_tet_cell_array`] reads one numeric cell array (an error indicator,
+//! say) at the tetrahedra of a file, in the order [`read`] lists them.
 
 use super::{read_bytes, write_atomic, IoError};
 use crate::geom::tet_quality;
@@ -787,6 +790,40 @@ impl Layout<'_> {
 
 /// Reads a `.vtu` file: its tetrahedra, points and regions.
 pub fn read(path: &Path) -> Result<MeshData, IoError> {
+    with_pieces(path, |layout, elems, pieces| {
+        let mut data = MeshData::default();
+        let mut any_region = false;
+        let mut regions: Vec<i32> = Vec::new();
+        for piece in pieces {
+            read_piece(
+                path,
+                layout,
+                elems,
+                piece,
+                &mut data,
+                &mut regions,
+                &mut any_region,
+            )?;
+        }
+        if data.tets.is_empty() {
+            return Err(IoError::file(
+                path,
+                "no tetrahedra (VTK cell type 10): not a volume mesh",
+            ));
+        }
+        if any_region {
+            data.tet_regions = regions;
+        }
+        Ok(data)
+    })
+}
+
+/// Parses a `.vtu` file (XML, binary layout, root checks) and hands its
+/// `<Piece>` elements, in file order, to `body`.
+fn with_pieces<R>(
+    path: &Path,
+    body: impl FnOnce(&Layout, &[Element], &[&Element]) -> Result<R, IoError>,
+) -> Result<R, IoError> {
     let bytes = read_bytes(path)?;
     if bytes.iter().all(|c| c.is_ascii_whitespace()) {
         return Err(IoError::file(path, "empty file"));
@@ -887,30 +924,134 @@ pub fn read(path: &Path) -> Result<MeshData, IoError> {
     if pieces.is_empty() {
         return Err(IoError::at(path, grid.line, "no <Piece> element"));
     }
-    let mut data = MeshData::default();
-    let mut any_region = false;
-    let mut regions: Vec<i32> = Vec::new();
-    for piece in pieces {
-        read_piece(
-            path,
-            &layout,
-            &elems,
-            piece,
-            &mut data,
-            &mut regions,
-            &mut any_region,
-        )?;
-    }
-    if data.tets.is_empty() {
-        return Err(IoError::file(
-            path,
-            "no tetrahedra (VTK cell type 10): not a volume mesh",
+    body(&layout, &elems, &pieces)
+}
+
+/// A numeric cell array of a `.vtu`, restricted to its tetrahedra: what
+/// [`read_tet_cell_array`] returns.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TetCellArray {
+    /// One value per tetrahedron (VTK cell type 10), in file order over all
+    /// pieces: the order in which [`read`] lists the tets. Integer arrays are
+    /// converted to `f64`.
+    pub values: Vec<f64>,
+    /// Per value, the 1-based file line of the `<DataArray>` element that
+    /// holds it (for messages).
+    pub lines: Vec<u32>,
+}
+
+/// Reads the one-component cell array `name` of a `.vtu` file, keeping the
+/// values of the tetrahedra only (the cells [`read`] keeps, in the same
+/// order), so that value `i` belongs to tet `i` of the mesh read from the
+/// same file. Every piece must carry the array. The values are not checked
+/// (NaN and infinities pass through).
+pub fn read_tet_cell_array(path: &Path, name: &str) -> Result<TetCellArray, IoError> {
+    with_pieces(path, |layout, elems, pieces| {
+        let mut out = TetCellArray {
+            values: Vec::new(),
+            lines: Vec::new(),
+        };
+        for piece in pieces {
+            read_piece_cell_array(path, layout, elems, piece, name, &mut out)?;
+        }
+        Ok(out)
+    })
+}
+
+fn read_piece_cell_array(
+    path: &Path,
+    layout: &Layout,
+    elems: &[Element],
+    piece: &Element,
+    name: &str,
+    out: &mut TetCellArray,
+) -> Result<(), IoError> {
+    let nc = count_attr(path, piece, "NumberOfCells")?;
+    let child = |e: &Element, child_name: &str| {
+        e.children
+            .iter()
+            .map(|&i| &elems[i])
+            .find(|c| c.name == child_name)
+    };
+    let arrays = |e: &Element| -> Vec<&Element> {
+        e.children
+            .iter()
+            .map(|&i| &elems[i])
+            .filter(|c| c.name == "DataArray")
+            .collect()
+    };
+    let at = |e: &Element, m: String| IoError::at(path, e.line, m);
+    let cells = child(piece, "Cells").ok_or_else(|| at(piece, "<Piece> without <Cells>".into()))?;
+    let typ_e = arrays(cells)
+        .into_iter()
+        .find(|a| a.attr("Name") == Some("types"))
+        .ok_or_else(|| at(cells, "<Cells> without a 'types' array".into()))?;
+    let types = match layout.values(typ_e)?.0 {
+        Values::Ints(v) => v,
+        Values::Floats(_) => {
+            return Err(at(typ_e, "DataArray 'types' must hold integers".into()));
+        }
+    };
+    if types.len() != nc {
+        return Err(at(
+            typ_e,
+            format!("{} cell types for {nc} cells", types.len()),
         ));
     }
-    if any_region {
-        data.tet_regions = regions;
+    let cell_data = child(piece, "CellData");
+    let found = cell_data.and_then(|cd| {
+        arrays(cd)
+            .into_iter()
+            .find(|a| a.attr("Name") == Some(name))
+    });
+    let Some(array) = found else {
+        let names: Vec<String> = cell_data
+            .map(|cd| {
+                arrays(cd)
+                    .iter()
+                    .filter_map(|a| a.attr("Name"))
+                    .map(|n| format!("'{n}'"))
+                    .collect()
+            })
+            .unwrap_or_default();
+        let have = if names.is_empty() {
+            "it has no named cell arrays".to_string()
+        } else {
+            format!("its cell arrays are {}", names.join(", "))
+        };
+        let e = cell_data.unwrap_or(piece);
+        return Err(at(
+            e,
+            format!("no cell array '{name}' in this <Piece>; {have}"),
+        ));
+    };
+    let (values, comps) = layout.values(array)?;
+    if comps != 1 {
+        return Err(at(
+            array,
+            format!("cell array '{name}' has {comps} components; expected 1 (a scalar per cell)"),
+        ));
     }
-    Ok(data)
+    if values.len() != nc {
+        return Err(at(
+            array,
+            format!(
+                "cell array '{name}' holds {} values for {nc} cells",
+                values.len()
+            ),
+        ));
+    }
+    let values: Vec<f64> = match values {
+        Values::Floats(v) => v,
+        Values::Ints(v) => v.into_iter().map(|x| x as f64).collect(),
+    };
+    for (&ty, &x) in types.iter().zip(&values) {
+        if ty == VTK_TETRA as i64 {
+            out.values.push(x);
+            out.lines.push(array.line as u32);
+        }
+    }
+    Ok(())
 }
 
 fn find(hay: &[u8], needle: &[u8]) -> Option<usize> {

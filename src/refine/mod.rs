@@ -18,6 +18,7 @@
 //! stale; `parent` and `level` carry what callers need.
 
 pub mod features;
+pub mod marking;
 pub mod parents;
 pub mod step;
 

@@ -1,0 +1,5 @@
+MeshVersionFormatted 2
+
+Dimension 3
+
+End

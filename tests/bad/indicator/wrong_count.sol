@@ -1,0 +1,15 @@
+MeshVersionFormatted 2
+
+Dimension 3
+
+SolAtTetrahedra
+5
+1 1
+
+0.1
+0.2
+0.3
+0.4
+0.5
+
+End
