@@ -4,6 +4,10 @@
 use super::progress::BarProgress;
 use std::path::PathBuf;
 use std::time::Instant;
+use tetrefine::io::indicator::read_indicator;
+use tetrefine::io::vtk::CellArray;
+use tetrefine::refine::marking::{select, MarkStrategy};
+use tetrefine::refine::step::descendants_of_last_step;
 use tetrefine::refine::{
     locate_parents, refine_step_with_progress, BoundaryRule, Phase, RefineOptions,
 };
@@ -58,6 +62,75 @@ pub struct Args {
     /// Write the output feature edges as polylines (.vtp for ParaView, or .csv).
     #[arg(long)]
     pub features_out: Option<PathBuf>,
+    /// Per-tet error indicator: a text file (one value per line), CSV
+    /// `tet,value` (0-based ids), Medit `.sol` (SolAtTetrahedra or
+    /// SolAtVertices) or `FILE.vtu:ARRAY`.
+    #[arg(long)]
+    pub indicator: Option<String>,
+    /// Marking strategy (repeatable; selections combine as a union):
+    /// fraction:F, doerfler:θ, max:γ, threshold:X (these need --indicator),
+    /// region:ID[,ID…], box:x0,y0,z0,x1,y1,z1, sphere:x,y,z,r.
+    #[arg(long = "mark")]
+    pub marks: Vec<String>,
+    /// Select the tets of these regions (same as --mark region:…).
+    #[arg(long)]
+    pub region: Option<String>,
+    /// Select the tets whose centroid is in this box (same as --mark box:…).
+    #[arg(long = "box", allow_hyphen_values = true)]
+    pub select_box: Option<String>,
+    /// Select the tets whose centroid is in this sphere (same as --mark sphere:…).
+    #[arg(long, allow_hyphen_values = true)]
+    pub sphere: Option<String>,
+    /// With a selection: `refined` (default) lets smoothing and edge removal
+    /// touch only the refined zone, so tets sharing no vertex with it come
+    /// out bit-identical; `all` optimises everywhere.
+    #[arg(long, default_value = "refined")]
+    pub smooth: SmoothScope,
+    /// Write `new_tet parent_tet` per line (0-based output and input ids), so
+    /// a solver can carry its fields over.
+    #[arg(long)]
+    pub parent_map: Option<PathBuf>,
+}
+
+/// Where the optimize phase may act in adaptive refinement.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum SmoothScope {
+    /// Only the refined zone.
+    Refined,
+    /// The whole mesh.
+    All,
+}
+
+/// The union of every selection option, or `None` for uniform refinement.
+fn mark_strategy(a: &Args) -> Result<Option<MarkStrategy>, String> {
+    let mut specs: Vec<String> = a.marks.clone();
+    if let Some(r) = &a.region {
+        specs.push(format!("region:{r}"));
+    }
+    if let Some(b) = &a.select_box {
+        specs.push(format!("box:{b}"));
+    }
+    if let Some(s) = &a.sphere {
+        specs.push(format!("sphere:{s}"));
+    }
+    if specs.is_empty() {
+        if a.indicator.is_some() {
+            return Err("--indicator needs a marking strategy: --mark fraction:F, doerfler:θ, max:γ or threshold:X".into());
+        }
+        return Ok(None);
+    }
+    let parts = specs
+        .iter()
+        .map(|s| {
+            s.parse::<MarkStrategy>()
+                .map_err(|e| format!("--mark {s}: {e}"))
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    let strategy = MarkStrategy::union(parts);
+    if strategy.needs_indicator() && a.indicator.is_none() {
+        return Err(format!("--mark {strategy} needs --indicator FILE"));
+    }
+    Ok(Some(strategy))
 }
 
 /// Runs `refine`.
@@ -81,15 +154,34 @@ pub fn run(a: Args) -> super::CliResult {
     if let Some(f) = &a.features_out {
         tetrefine::surface::ifs::PolylineFormat::of(f).map_err(|e| e.to_string())?;
     }
+    let strategy = mark_strategy(&a)?;
     let mut input = super::load(&a.input)?;
+    let selection = match &strategy {
+        Some(st) => {
+            let values = match &a.indicator {
+                Some(spec) => Some(read_indicator(spec, &input).map_err(|e| e.to_string())?),
+                None => None,
+            };
+            let sel =
+                select(st, values.as_deref(), &input).map_err(|e| format!("--mark {st}: {e}"))?;
+            eprintln!(
+                "selected {} of {} tets ({st})",
+                sel.iter().filter(|&&x| x).count(),
+                input.n_tets()
+            );
+            Some(sel)
+        }
+        None => None,
+    };
     super::apply_feature_option(&mut input, &a.features, a.feature_angle)?;
     let mut mesh = input.clone();
-    let opts = RefineOptions {
+    let mut opts = RefineOptions {
         boundary: a.boundary,
         opt_passes: a.opt_passes,
         threshold: a.threshold,
         stop_after: a.stop_after,
-        selection: None,
+        selection: selection.clone(),
+        smooth_refined_only: selection.is_some() && a.smooth == SmoothScope::Refined,
         check_each_phase: false,
     };
     let t0 = Instant::now();
@@ -99,6 +191,9 @@ pub fn run(a: Args) -> super::CliResult {
     let mut steps = vec![StepStats::input(first)];
     let progress = BarProgress::new();
     for s in 1..=a.steps {
+        if s > 1 && opts.selection.is_some() {
+            opts.selection = Some(descendants_of_last_step(&mesh, s - 1));
+        }
         let report = refine_step_with_progress(&mut mesh, s, &opts, &progress);
         let stats = MeshStats::compute(&mesh);
         println!("{}", step_row(&format!("step {s}"), &stats, report.seconds));
@@ -117,7 +212,38 @@ pub fn run(a: Args) -> super::CliResult {
         tetrefine::io::write_atomic(path, |w| std::io::Write::write_all(w, text.as_bytes()))
             .map_err(|e| e.to_string())?;
     }
-    super::write_refined(&a.output, &mut mesh, Vec::new())?;
+    mesh.compact();
+    let marked: Vec<i32> = mesh
+        .tet_ids()
+        .map(|t| {
+            let p = mesh.parent(t) as usize;
+            i32::from(
+                selection
+                    .as_ref()
+                    .is_none_or(|sel| sel.get(p).copied().unwrap_or(false)),
+            )
+        })
+        .collect();
+    if let Some(path) = &a.parent_map {
+        let ids: Vec<u32> = mesh.tet_ids().collect();
+        tetrefine::io::write_atomic(path, |w| {
+            use std::io::Write;
+            writeln!(
+                w,
+                "# new_tet parent_tet (0-based; parent = input tet holding the centroid)"
+            )?;
+            for (i, &t) in ids.iter().enumerate() {
+                writeln!(w, "{i} {}", mesh.parent(t))?;
+            }
+            Ok(())
+        })
+        .map_err(|e| e.to_string())?;
+    }
+    super::write_refined(
+        &a.output,
+        &mut mesh,
+        vec![CellArray::Int32("marked".into(), marked)],
+    )?;
     if let Some(f) = &a.features_out {
         super::write_feature_lines(f, &mesh)?;
     }

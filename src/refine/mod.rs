@@ -160,6 +160,10 @@ pub struct RefineOptions {
     pub stop_after: Option<Phase>,
     /// Per tet slot: is it selected for splitting? `None` = every tet.
     pub selection: Option<Vec<bool>>,
+    /// `--smooth refined`: the optimize phase moves only vertices of tets
+    /// refined in this step and removes only their edges, so tets that share
+    /// no vertex with a refined tet come out bit-identical.
+    pub smooth_refined_only: bool,
     /// Run [`TetMesh::check`](crate::TetMesh::check) after every phase and
     /// record failures in [`StepReport::check_failures`] (tests, debugging).
     pub check_each_phase: bool,
@@ -173,6 +177,7 @@ impl Default for RefineOptions {
             threshold: 0.3,
             stop_after: None,
             selection: None,
+            smooth_refined_only: false,
             check_each_phase: false,
         }
     }

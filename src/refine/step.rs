@@ -14,8 +14,29 @@ use std::collections::{HashMap, HashSet};
 use std::time::Instant;
 
 /// Runs `steps` refinement steps; one report per step.
+///
+/// With a selection (adaptive refinement, seed paper §6), step 1 splits the
+/// selected tets and every later step splits their descendants again — the
+/// tets whose `level` the previous step raised — so the selected zone is
+/// refined `steps` times (the paper's Figure 13).
 pub fn refine(mesh: &mut TetMesh, steps: usize, opts: &RefineOptions) -> Vec<StepReport> {
-    (1..=steps).map(|s| refine_step(mesh, s, opts)).collect()
+    let mut reports = Vec::with_capacity(steps);
+    let mut step_opts = opts.clone();
+    for s in 1..=steps {
+        if s > 1 && opts.selection.is_some() {
+            step_opts.selection = Some(descendants_of_last_step(mesh, s - 1));
+        }
+        reports.push(refine_step(mesh, s, &step_opts));
+    }
+    reports
+}
+
+/// Per tet slot: was it refined in step `step` (its level is `step`)? With a
+/// selection, only refined tets reach the step's level.
+pub fn descendants_of_last_step(mesh: &TetMesh, step: usize) -> Vec<bool> {
+    (0..mesh.n_tet_slots() as u32)
+        .map(|t| mesh.is_alive(t) && usize::from(mesh.level(t)) >= step)
+        .collect()
 }
 
 /// State carried from phase to phase within one step.
@@ -76,11 +97,18 @@ pub fn refine_step_with_progress(
                 // of the arrays; bring neighbours together in memory first.
                 mesh.reorder_spatially();
                 if opts.opt_passes > 0 {
+                    let (movable, tet_allowed) = if opts.smooth_refined_only {
+                        refined_zone(mesh, step)
+                    } else {
+                        (None, None)
+                    };
                     report.improve = improve(
                         mesh,
                         &ImproveOptions {
                             passes: opts.opt_passes,
                             threshold: opts.threshold,
+                            movable,
+                            tet_allowed,
                             ..Default::default()
                         },
                     );
@@ -104,6 +132,22 @@ pub fn refine_step_with_progress(
     }
     report.seconds = start.elapsed().as_secs_f64();
     report
+}
+
+/// The tets refined in this step (their level reached `step`) and their
+/// vertices: what `--smooth refined` lets the optimize phase touch.
+#[allow(clippy::type_complexity)]
+fn refined_zone(mesh: &TetMesh, step: usize) -> (Option<Vec<bool>>, Option<Vec<bool>>) {
+    let tets = descendants_of_last_step(mesh, step);
+    let mut verts = vec![false; mesh.n_points()];
+    for t in mesh.tet_ids() {
+        if tets[t as usize] {
+            for v in mesh.tet(t) {
+                verts[v as usize] = true;
+            }
+        }
+    }
+    (Some(verts), Some(tets))
 }
 
 /// Phase 1: 1-4 split of every selected tet at its barycentre.
