@@ -16,9 +16,21 @@ pub struct StepStats {
     pub phases: Vec<PhaseReport>,
     /// Wall time of the step.
     pub seconds: f64,
+    /// Peak resident memory of the process so far (`VmHWM` of
+    /// `/proc/self/status`; absent where that file does not exist).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub peak_rss_bytes: Option<u64>,
     /// What the step did, operation by operation (absent for the input).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub report: Option<StepReport>,
+}
+
+/// Peak resident set size of this process in bytes, from `/proc/self/status`.
+pub fn peak_rss_bytes() -> Option<u64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb * 1024)
 }
 
 impl StepStats {
@@ -28,6 +40,7 @@ impl StepStats {
             stats,
             phases: Vec::new(),
             seconds: 0.0,
+            peak_rss_bytes: peak_rss_bytes(),
             report: None,
         }
     }
@@ -38,6 +51,7 @@ impl StepStats {
             stats,
             phases: report.phases.clone(),
             seconds: report.seconds,
+            peak_rss_bytes: peak_rss_bytes(),
             report: Some(report.clone()),
         }
     }
