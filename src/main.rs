@@ -20,7 +20,7 @@ enum Command {
     /// Convert a mesh between formats, keeping regions, markers and features.
     Convert(cli::convert::Args),
     /// Refine with the √3 tetrahedral subdivision (uniform).
-    Refine(cli::refine::Args),
+    Refine(Box<cli::refine::Args>),
     /// Improve a mesh (edge removal and smoothing), boundary fixed.
     Improve(cli::improve::Args),
     /// Subdivide a polygon surface (√3, Loop, Catmull–Clark, Doo–Sabin, weighted Catmull–Clark,
@@ -35,7 +35,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Quality(a) => cli::quality::run(a),
         Command::Convert(a) => cli::convert::run(a),
-        Command::Refine(a) => cli::refine::run(a),
+        Command::Refine(a) => cli::refine::run(*a),
         Command::Improve(a) => cli::improve::run(a),
         Command::Surface(a) => cli::surface::run(*a),
         Command::Mesh(a) => cli::mesh::run(a),

@@ -177,7 +177,7 @@ fn check_options(a: &Args, features: &Features) -> Result<(), String> {
                 "ifs needs --kind cubic-bspline, four-point, bicubic, koch or gasket".into(),
             );
         }
-        if a.kind == Some(IfsKindArg::Bicubic) && !a.grid.as_ref().is_some_and(|g| g.len() == 2) {
+        if a.kind == Some(IfsKindArg::Bicubic) && a.grid.as_ref().is_none_or(|g| g.len() != 2) {
             return Err("ifs --kind bicubic needs --grid NU,NV (the control grid size)".into());
         }
         if a.input.is_none() && !matches!(a.kind, Some(IfsKindArg::Koch) | Some(IfsKindArg::Gasket))

@@ -868,7 +868,7 @@ impl Analysis {
                         }
                         if la.area > lb.area
                             && inside_loop(&la.uv, ip)
-                            && parent[b].map_or(true, |p| g.loops[p].area > la.area)
+                            && parent[b].is_none_or(|p| g.loops[p].area > la.area)
                         {
                             parent[b] = Some(a);
                         }
@@ -1295,7 +1295,7 @@ impl Analysis {
         for (k, p) in self.pieces.iter().enumerate() {
             for s in [1.0, -1.0] {
                 let sh = shell_of_side[side(k, s) as usize];
-                if start[sh].map_or(true, |(b, _)| self.pieces[b].area < p.area) {
+                if start[sh].is_none_or(|(b, _)| self.pieces[b].area < p.area) {
                     start[sh] = Some((k, s));
                 }
             }
