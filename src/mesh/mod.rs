@@ -18,6 +18,7 @@ mod build;
 mod check;
 mod compact;
 mod data;
+pub mod fasthash;
 pub mod generate;
 mod reorder;
 

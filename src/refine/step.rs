@@ -2,6 +2,7 @@
 
 use super::{NoProgress, Phase, PhaseReport, Progress, RefineOptions, StepReport};
 use crate::geom::TET_EDGES;
+use crate::mesh::fasthash::FastHashMap;
 use crate::mesh::{edge_key, TetMarks, TetMesh, NO_ADJ};
 use crate::ops::{
     flip23, flip23_valid, remove_edge, remove_interface_edge, split14, split_boundary_face,
@@ -407,8 +408,8 @@ fn flat_enough(mesh: &TetMesh, a: u32, b: u32, m1: u32, m2: u32) -> bool {
 fn boundary_flip_phase(mesh: &mut TetMesh, st: &mut StepState, report: &mut StepReport) {
     let fp = st.first_face_point;
     // Old edges seen from the split faces, with how often and one face point.
-    let mut seen: HashMap<[u32; 2], (u32, u8)> =
-        HashMap::with_capacity(3 * st.split_faces.len() / 2);
+    let mut seen: FastHashMap<[u32; 2], (u32, u8)> =
+        FastHashMap::with_capacity_and_hasher(3 * st.split_faces.len() / 2, Default::default());
     for &(f, m) in st.split_faces.iter().chain(&st.split_interfaces) {
         for i in 0..3 {
             let k = edge_key(f[i], f[(i + 1) % 3]);
@@ -416,7 +417,7 @@ fn boundary_flip_phase(mesh: &mut TetMesh, st: &mut StepState, report: &mut Step
         }
     }
     let mut edges: Vec<([u32; 2], u32)> = seen.iter().map(|(k, (m, _))| (*k, *m)).collect();
-    let seen_count: HashMap<[u32; 2], u8> = seen.iter().map(|(k, (_, n))| (*k, *n)).collect();
+    let seen_count: FastHashMap<[u32; 2], u8> = seen.iter().map(|(k, (_, n))| (*k, *n)).collect();
     edges.sort_unstable();
     let even = st.step % 2 == 0;
     let mut ball = Vec::new();

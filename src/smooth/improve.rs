@@ -12,9 +12,9 @@
 use super::laplacian::laplacian_smooth;
 use super::optimize::{optimize_vertex, OptimizeParams};
 use crate::geom::{tet_min_sine, TET_EDGES};
+use crate::mesh::fasthash::FastHashSet;
 use crate::mesh::{edge_key, TetMarks, TetMesh, NO_ADJ};
 use crate::ops::{remove_edge, EdgeRing};
-use std::collections::HashSet;
 
 /// Options of [`improve`].
 #[derive(Clone, Debug)]
@@ -187,7 +187,8 @@ pub fn improve(mesh: &mut TetMesh, opts: &ImproveOptions) -> ImproveReport {
         for &t in &candidates {
             tr.tet_dirty[t as usize] = false;
         }
-        let mut tried: HashSet<[u32; 2]> = HashSet::with_capacity(4 * candidates.len());
+        let mut tried: FastHashSet<[u32; 2]> =
+            FastHashSet::with_capacity_and_hasher(4 * candidates.len(), Default::default());
         for t in candidates {
             if !mesh.is_alive(t) || tr.tq[t as usize] >= opts.edge_threshold {
                 continue;
