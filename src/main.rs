@@ -21,6 +21,8 @@ enum Command {
     Convert(cli::convert::Args),
     /// Subdivide a polygon surface (√3, Loop, Catmull–Clark, Doo–Sabin, weighted Catmull–Clark).
     Surface(cli::surface::Args),
+    /// Uniform 1:8 red refinement by edge bisection (the speed-of-light reference).
+    Bisect(cli::bisect::Args),
 }
 
 fn main() -> ExitCode {
@@ -29,6 +31,7 @@ fn main() -> ExitCode {
         Command::Quality(a) => cli::quality::run(a),
         Command::Convert(a) => cli::convert::run(a),
         Command::Surface(a) => cli::surface::run(a),
+        Command::Bisect(a) => cli::bisect::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -13,6 +13,7 @@
 //! 6. `optimize` — interior edge removal and vertex smoothing
 //!    ([`crate::smooth::improve`]).
 
+pub mod bisect;
 pub mod features;
 pub mod parents;
 pub mod step;
