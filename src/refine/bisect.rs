@@ -204,14 +204,14 @@ fn build_template(diagonal: usize) -> Template {
         sub: 0,
     }; 4]; 8];
     let mut on_face = [[(u8::MAX, u8::MAX); 5]; 4];
-    for c in 0..8 {
-        for f in 0..4 {
+    for (c, child_links) in links.iter_mut().enumerate() {
+        for (f, link) in child_links.iter_mut().enumerate() {
             let k = face_nodes(c, f);
             let sibling = (0..8)
                 .filter(|&c2| c2 != c)
                 .flat_map(|c2| (0..4).map(move |f2| (c2, f2)))
                 .find(|&(c2, f2)| face_nodes(c2, f2) == k);
-            links[c][f] = match sibling {
+            *link = match sibling {
                 Some((c2, f2)) => Link::Inner {
                     child: c2 as u8,
                     face: f2 as u8,
@@ -397,8 +397,8 @@ fn bisect_dense(m: &TetMesh) -> Result<TetMesh, BisectError> {
                 if bad.is_none() && orient3d_sign(s[0], s[1], s[2], s[3]) != Orientation::Positive {
                     bad = Some((t, c));
                 }
-                for f in 0..4 {
-                    ac[c][f] = match tp.links[c][f] {
+                for (a, &link) in ac[c].iter_mut().zip(&tp.links[c]) {
+                    *a = match link {
                         Link::Inner { child, face } => {
                             4 * (8 * t as u32 + child as u32) + face as u32
                         }
