@@ -183,7 +183,7 @@ for label, name in rows:
     n = q["tets"]
     rate = n / s if s > 0 else float("inf")
     mn, mx = q["min_dihedral_deg"], q["max_dihedral_deg"]
-    print(f"| {label} | {s:.2f} | {n:,} | {rate/1e6:.2f} M | {mn['worst']:.2f} / {mn['avg']:.2f} | {mx['worst']:.2f} | {mb:.0f} |")
+    print(f"| {label} | {s:.2f} | {n:,} | {rate/1e6:.3g} M | {mn['worst']:.2f} / {mn['avg']:.2f} | {mx['worst']:.2f} | {mb:.0f} |")
 print()
 print("Commands (as run):")
 print()
