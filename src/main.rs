@@ -28,6 +28,8 @@ enum Command {
     Surface(Box<cli::surface::Args>),
     /// Mesh the volume a closed surface encloses, with TetGen (opt-in feature `tetgen`).
     Mesh(cli::mesh::Args),
+    /// Uniform 1:8 red refinement by edge bisection (the speed-of-light reference).
+    Bisect(cli::bisect::Args),
 }
 
 fn main() -> ExitCode {
@@ -39,6 +41,7 @@ fn main() -> ExitCode {
         Command::Improve(a) => cli::improve::run(a),
         Command::Surface(a) => cli::surface::run(*a),
         Command::Mesh(a) => cli::mesh::run(a),
+        Command::Bisect(a) => cli::bisect::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

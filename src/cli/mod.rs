@@ -1,6 +1,7 @@
 //! Subcommands, one file each. Every command returns `Err(message)` for the
 //! user; `main` prints it on one line and exits non-zero.
 
+pub mod bisect;
 pub mod convert;
 pub mod improve;
 pub mod mesh;

@@ -17,6 +17,7 @@
 //! a space-filling curve before `optimize`), so ids held across a step are
 //! stale; `parent` and `level` carry what callers need.
 
+pub mod bisect;
 pub mod features;
 pub mod marking;
 pub mod parents;

@@ -1,0 +1,38 @@
+//! `tetrefine bisect IN -o OUT [--steps N]`: uniform 1:8 red refinement, the
+//! speed-of-light reference for the √3 step.
+
+use std::path::PathBuf;
+use std::time::Instant;
+use tetrefine::refine::bisect::bisect;
+
+/// Arguments of `bisect`.
+#[derive(clap::Args)]
+pub struct Args {
+    /// Input mesh.
+    pub input: PathBuf,
+    /// Output mesh (.vtu, .mesh, .msh, .node).
+    #[arg(short, long)]
+    pub output: PathBuf,
+    /// Number of 1:8 steps.
+    #[arg(long, default_value_t = 1)]
+    pub steps: usize,
+}
+
+/// Runs `bisect`.
+pub fn run(a: Args) -> super::CliResult {
+    tetrefine::io::Format::for_writing(&a.output).map_err(|e| e.to_string())?;
+    let mut mesh = super::load(&a.input)?;
+    for s in 1..=a.steps {
+        let t0 = Instant::now();
+        let before = mesh.n_tets();
+        mesh = bisect(&mesh).map_err(|e| format!("{}: step {s}: {e}", a.input.display()))?;
+        let secs = t0.elapsed().as_secs_f64();
+        println!(
+            "step {s}: {before} -> {} tets, {} points, {secs:.3} s ({:.1} M output tets/s)",
+            mesh.n_tets(),
+            mesh.n_points(),
+            mesh.n_tets() as f64 / secs.max(1e-9) / 1e6
+        );
+    }
+    tetrefine::io::write_mesh(&a.output, &mesh).map_err(|e| e.to_string())
+}
