@@ -27,7 +27,7 @@ pub fn run(a: Args) -> super::CliResult {
         let before = mesh.n_tets();
         mesh = bisect(&mesh).map_err(|e| format!("{}: step {s}: {e}", a.input.display()))?;
         let secs = t0.elapsed().as_secs_f64();
-        println!(
+        crate::say!(
             "step {s}: {before} -> {} tets, {} points, {secs:.3} s ({:.1} M output tets/s)",
             mesh.n_tets(),
             mesh.n_points(),

@@ -31,7 +31,7 @@ pub fn run(a: Args) -> super::CliResult {
         },
     );
     let after = MeshStats::compute(&mesh);
-    println!(
+    crate::say!(
         "min dihedral worst/avg: {:.2}° / {:.2}° -> {:.2}° / {:.2}°  ({} edges removed, {} Laplacian and {} optimized moves in {} passes)",
         before.min_dihedral_deg.worst,
         before.min_dihedral_deg.avg,

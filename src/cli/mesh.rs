@@ -66,7 +66,7 @@ pub fn run(a: Args) -> super::CliResult {
     let mut regions: Vec<i32> = mesh.tet_ids().map(|t| mesh.region(t)).collect();
     regions.sort_unstable();
     regions.dedup();
-    println!(
+    crate::say!(
         "{}: {} points, {} tetrahedra, regions {:?}",
         a.output.display(),
         mesh.n_points(),

@@ -16,6 +16,17 @@ use tetrefine::report::histogram::{write_histogram as write_hist_file, Histogram
 use tetrefine::report::MeshStats;
 use tetrefine::TetMesh;
 
+/// `println!` that ignores a closed pipe (`tetrefine quality … | head`):
+/// standard output is a courtesy, the files are the product, and a reader
+/// that stopped early must not turn into a panic.
+#[macro_export]
+macro_rules! say {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        let _ = writeln!(std::io::stdout().lock(), $($arg)*);
+    }};
+}
+
 /// A one-line error for the user.
 pub type CliResult = Result<(), String>;
 

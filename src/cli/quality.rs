@@ -60,7 +60,7 @@ pub fn run(a: Args) -> super::CliResult {
 
     if a.json {
         let json = serde_json::to_string(&stats).map_err(|e| e.to_string())?;
-        println!("{json}");
+        crate::say!("{json}");
     } else {
         let name = file_name(&a.input);
         print!("{}", format_table(&[(name.as_str(), &stats)]));

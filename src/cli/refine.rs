@@ -186,8 +186,8 @@ pub fn run(a: Args) -> super::CliResult {
     };
     let t0 = Instant::now();
     let first = MeshStats::compute(&mesh);
-    println!("{}", step_table_header());
-    println!("{}", step_row("input", &first, 0.0));
+    crate::say!("{}", step_table_header());
+    crate::say!("{}", step_row("input", &first, 0.0));
     let mut steps = vec![StepStats::input(first)];
     let progress = BarProgress::new();
     for s in 1..=a.steps {
@@ -196,7 +196,7 @@ pub fn run(a: Args) -> super::CliResult {
         }
         let report = refine_step_with_progress(&mut mesh, s, &opts, &progress);
         let stats = MeshStats::compute(&mesh);
-        println!("{}", step_row(&format!("step {s}"), &stats, report.seconds));
+        crate::say!("{}", step_row(&format!("step {s}"), &stats, report.seconds));
         if report.refused_flips + report.refused_boundary_flips + report.skipped_moves > 0 {
             eprintln!(
                 "note: step {s}: {} interior flips and {} boundary flips refused, {} boundary moves skipped (each would have inverted a tet)",
