@@ -68,3 +68,20 @@ fn tripod_full_step_quality() {
         assert_eq!(s.inverted, 0);
     }
 }
+
+#[test]
+fn tripod_second_step_adds_one_point_per_tet_and_boundary_face() {
+    // After step 1 the mesh has 5,476 vertices, T1 tets and 5,130 boundary
+    // faces; step 2 adds one barycentre per tet and one point per boundary
+    // face.
+    let mut m = tripod();
+    let opts = RefineOptions::default();
+    refine_step(&mut m, 1, &opts);
+    let s1 = MeshStats::compute(&m);
+    assert_eq!((s1.nodes, s1.boundary_faces), (5_476, 5_130));
+    refine_step(&mut m, 2, &opts);
+    m.check().unwrap();
+    let s2 = MeshStats::compute(&m);
+    assert_eq!(s2.nodes, 5_476 + s1.tets + 5_130);
+    assert_eq!(s2.boundary_faces, 3 * 5_130);
+}
