@@ -90,6 +90,11 @@ pub struct Args {
     /// a solver can carry its fields over.
     #[arg(long)]
     pub parent_map: Option<PathBuf>,
+    /// Refinement rounds already done on this mesh (in an adaptive loop,
+    /// the round number): feature edges are kept in odd and trisected in
+    /// even global steps.
+    #[arg(long, default_value_t = 0)]
+    pub step_offset: usize,
 }
 
 /// Where the optimize phase may act in adaptive refinement.
@@ -182,6 +187,7 @@ pub fn run(a: Args) -> super::CliResult {
         stop_after: a.stop_after,
         selection: selection.clone(),
         smooth_refined_only: selection.is_some() && a.smooth == SmoothScope::Refined,
+        step_offset: a.step_offset,
         check_each_phase: false,
     };
     let t0 = Instant::now();

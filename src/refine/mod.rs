@@ -165,6 +165,12 @@ pub struct RefineOptions {
     /// refined in this step and removes only their edges, so tets that share
     /// no vertex with a refined tet come out bit-identical.
     pub smooth_refined_only: bool,
+    /// Refinement rounds done before this run (an adaptive loop that refines
+    /// once per solve passes its round number): the crease rule keeps
+    /// feature edges in odd global steps and trisects them in even ones, so
+    /// without it every one-step run would keep them and the faces along
+    /// them would thin out round after round.
+    pub step_offset: usize,
     /// Run [`TetMesh::check`](crate::TetMesh::check) after every phase and
     /// record failures in [`StepReport::check_failures`] (tests, debugging).
     pub check_each_phase: bool,
@@ -179,6 +185,7 @@ impl Default for RefineOptions {
             stop_after: None,
             selection: None,
             smooth_refined_only: false,
+            step_offset: 0,
             check_each_phase: false,
         }
     }

@@ -80,7 +80,7 @@ pub fn refine_step_with_progress(
         first_face_point: u32::MAX,
         split_faces: Vec::new(),
         split_interfaces: Vec::new(),
-        step,
+        step: step + opts.step_offset,
         creases: mesh.feature_edges().keys().copied().collect(),
         trisected: HashSet::new(),
     };
