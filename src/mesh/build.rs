@@ -284,14 +284,12 @@ impl TetMesh {
         // Two positive tets sharing a face must lie on opposite sides of it: the
         // neighbour's opposite vertex must be on the side our outward-oriented
         // face points to.
-        let overlap = (0..nt).into_par_iter().find_first(|&t| {
-            (0..4).any(|f| {
-                let h = adj[t][f];
-                if h == NO_ADJ || ((h >> 2) as usize) < t {
-                    return false;
-                }
-                let v = tets[t];
+        // Face `f` of `t` has a neighbour on the wrong side of it.
+        let overlaps = |t: usize, f: usize| {
+            let h = adj[t][f];
+            h != NO_ADJ && {
                 let l = TET_FACES[f];
+                let v = tets[t];
                 let o = tets[(h >> 2) as usize][(h & 3) as usize];
                 orient3d_sign(
                     points[v[l[0]] as usize],
@@ -299,25 +297,14 @@ impl TetMesh {
                     points[v[l[2]] as usize],
                     points[o as usize],
                 ) != Orientation::Positive
-            })
+            }
+        };
+        // Each shared face is tested once, from its lower tet.
+        let overlap = (0..nt).into_par_iter().find_first(|&t| {
+            (0..4).any(|f| adj[t][f] != NO_ADJ && ((adj[t][f] >> 2) as usize) > t && overlaps(t, f))
         });
         if let Some(t) = overlap {
-            let f = (0..4)
-                .find(|&f| {
-                    let h = adj[t][f];
-                    h != NO_ADJ && {
-                        let l = TET_FACES[f];
-                        let v = tets[t];
-                        let o = tets[(h >> 2) as usize][(h & 3) as usize];
-                        orient3d_sign(
-                            points[v[l[0]] as usize],
-                            points[v[l[1]] as usize],
-                            points[v[l[2]] as usize],
-                            points[o as usize],
-                        ) != Orientation::Positive
-                    }
-                })
-                .unwrap_or(0);
+            let f = (0..4).find(|&f| overlaps(t, f)).unwrap_or(0);
             let l = TET_FACES[f];
             let v = tets[t];
             return Err(MeshError::Overlap {
