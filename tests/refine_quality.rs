@@ -44,9 +44,13 @@ fn tripod_beats_table_1_in_every_boundary_mode() {
 }
 
 #[test]
-fn tripod_linear_and_approximating_keep_the_inputs_worst_angle() {
+fn tripod_keeps_the_inputs_worst_angle_in_every_boundary_mode() {
     // The input's worst minimum dihedral angle is 7.56° (DESIGN §4).
-    for rule in [BoundaryRule::Approximating, BoundaryRule::Linear] {
+    for rule in [
+        BoundaryRule::Interpolating,
+        BoundaryRule::Approximating,
+        BoundaryRule::Linear,
+    ] {
         let (mut mesh, _) = load_mesh(Path::new("meshes/tripod.mesh")).unwrap();
         let opts = RefineOptions {
             boundary: rule,
