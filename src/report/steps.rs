@@ -58,10 +58,11 @@ impl StepStats {
 }
 
 /// Header of the per-step table (the rows of Table 1 of the seed paper as
-/// columns, plus boundary faces, inverted tets and wall time).
+/// columns, plus boundary faces, inverted tets, feature edges, corners and
+/// wall time).
 pub fn step_table_header() -> String {
     format!(
-        "{:<8} {:>10} {:>11} {:>11} {:>9} {:>9} {:>9} {:>8} {:>7} {:>9} {:>8} {:>9}",
+        "{:<8} {:>10} {:>11} {:>11} {:>9} {:>9} {:>9} {:>8} {:>7} {:>9} {:>8} {:>9} {:>7} {:>9}",
         "",
         "nodes",
         "edges",
@@ -73,6 +74,8 @@ pub fn step_table_header() -> String {
         "val.max",
         "bnd.faces",
         "inverted",
+        "features",
+        "corners",
         "seconds"
     )
 }
@@ -80,7 +83,7 @@ pub fn step_table_header() -> String {
 /// One row of the per-step table.
 pub fn step_row(label: &str, s: &MeshStats, seconds: f64) -> String {
     format!(
-        "{:<8} {:>10} {:>11} {:>11} {:>9.2} {:>9.2} {:>9.2} {:>8.2} {:>7} {:>9} {:>8} {:>9.3}",
+        "{:<8} {:>10} {:>11} {:>11} {:>9.2} {:>9.2} {:>9.2} {:>8.2} {:>7} {:>9} {:>8} {:>9} {:>7} {:>9.3}",
         label,
         s.nodes,
         s.edges,
@@ -92,6 +95,8 @@ pub fn step_row(label: &str, s: &MeshStats, seconds: f64) -> String {
         s.valence.max,
         s.boundary_faces,
         s.inverted,
+        s.feature_edges,
+        s.corners,
         seconds
     )
 }
