@@ -447,12 +447,7 @@ pub fn read_sol(path: &Path, tets: &[[u32; 4]], n_points: usize) -> Result<Vec<f
     while let Some(kw) = tok.next() {
         saw_any = true;
         match kw {
-            "MeshVersionFormatted" => {
-                let v: i64 = tok.parse("a format version")?;
-                if !(1..=4).contains(&v) {
-                    return Err(tok.error(format!("unsupported MeshVersionFormatted {v}")));
-                }
-            }
+            "MeshVersionFormatted" => super::medit::read_version(&mut tok)?,
             "Dimension" => {
                 let d: i64 = tok.parse("the dimension")?;
                 if d != 3 {

@@ -67,19 +67,12 @@ fn parse(path: &Path) -> Result<MeshData, IoError> {
     let mut tok = Tokens::new(path, text, true);
     let mut data = MeshData::default();
     let mut raw_edges: Vec<([u32; 2], i32)> = Vec::new();
-    let mut ridges: Vec<u32> = Vec::new();
     let mut saw_vertices = false;
-    let mut saw_end = false;
     let mut saw_any = false;
     while let Some(kw) = tok.next() {
         saw_any = true;
         match kw {
-            "MeshVersionFormatted" => {
-                let v: i64 = tok.parse("a format version")?;
-                if !(1..=4).contains(&v) {
-                    return Err(tok.error(format!("unsupported MeshVersionFormatted {v}")));
-                }
-            }
+            "MeshVersionFormatted" => read_version(&mut tok)?,
             "Dimension" => {
                 let d: i64 = tok.parse("the dimension")?;
                 if d != 3 {
@@ -144,6 +137,8 @@ fn parse(path: &Path) -> Result<MeshData, IoError> {
                 }
             }
             "Ridges" | "RequiredEdges" => {
+                // Every listed edge is already a feature: only check the
+                // numbers name edges that exist.
                 let n = count(&mut tok, "edge count")?;
                 for _ in 0..n {
                     let e: i64 = tok.parse("an edge number")?;
@@ -153,7 +148,6 @@ fn parse(path: &Path) -> Result<MeshData, IoError> {
                             raw_edges.len()
                         )));
                     }
-                    ridges.push((e - 1) as u32);
                 }
             }
             "Corners" | "RequiredVertices" => {
@@ -169,10 +163,8 @@ fn parse(path: &Path) -> Result<MeshData, IoError> {
                     }
                 }
             }
-            "End" => {
-                saw_end = true;
-                break;
-            }
+            // `End` is optional in practice (many writers omit it).
+            "End" => break,
             other => match skipped_section_width(other) {
                 Some(w) => {
                     let n = count(&mut tok, "entry count")?;
@@ -196,10 +188,18 @@ fn parse(path: &Path) -> Result<MeshData, IoError> {
     if !saw_any {
         return Err(IoError::file(path, "empty file"));
     }
-    let _ = saw_end; // End is optional in practice (many writers omit it).
     data.edges = raw_edges;
-    let _ = ridges; // every listed edge is already a feature
     Ok(data)
+}
+
+/// Reads the number after `MeshVersionFormatted` (shared with the `.sol`
+/// reader): 1 to 4 are the versions of the libMeshb family.
+pub(crate) fn read_version(tok: &mut Tokens) -> Result<(), IoError> {
+    let v: i64 = tok.parse("a format version")?;
+    if !(1..=4).contains(&v) {
+        return Err(tok.error(format!("unsupported MeshVersionFormatted {v}")));
+    }
+    Ok(())
 }
 
 fn count(tok: &mut Tokens, what: &str) -> Result<usize, IoError> {

@@ -248,8 +248,23 @@ fn read_seeds(lines: &mut Lines, plc: &mut Plc) -> Result<(), IoError> {
     Ok(())
 }
 
-/// Reads a TetGen `.poly` file.
-pub fn read_poly(path: &Path) -> Result<Plc, IoError> {
+/// What the facet readers of `.poly` and `.smesh` get from the shared part
+/// of the file: the facet count, whether facets carry markers, the index
+/// base and the number of points.
+struct FacetSection {
+    count: usize,
+    markers: bool,
+    base: i64,
+    n_points: usize,
+}
+
+/// Reads a `.poly`-family file: the node section, the facet header, the
+/// facets (by `read_facets`, whose layout differs between `.poly` and
+/// `.smesh`), then holes and region seeds.
+fn read_plc_file(
+    path: &Path,
+    read_facets: impl FnOnce(&mut Lines, &FacetSection, &mut Plc) -> Result<(), IoError>,
+) -> Result<Plc, IoError> {
     let bytes = read_bytes(path)?;
     let text = as_text(path, &bytes)?;
     let mut lines = Lines::new(path, text);
@@ -257,91 +272,88 @@ pub fn read_poly(path: &Path) -> Result<Plc, IoError> {
         return Err(IoError::file(path, "empty file"));
     }
     let (points, base) = read_points(&mut lines, path)?;
-    let np = points.len();
+    let n_points = points.len();
     let mut plc = Plc {
         points,
         ..Default::default()
     };
     let (l, h) = lines.next("the facet count")?;
-    let nf = lines.count(l, h.first().copied(), "the facet count")?;
+    let count = lines.count(l, h.first().copied(), "the facet count")?;
     let markers = match h.get(1) {
         Some(m) => lines.parse::<i64>(l, Some(m), "the facet marker flag")? != 0,
         None => false,
     };
-    for _ in 0..nf {
-        let (l, t) = lines.next("a facet")?;
-        let npoly = lines.count(l, t.first().copied(), "the polygon count")?;
-        if npoly == 0 {
-            return Err(lines.error(l, "a facet must have at least one polygon"));
-        }
-        let nholes = match t.get(1) {
-            Some(x) => lines.count(l, Some(x), "the facet hole count")?,
-            None => 0,
-        };
-        let marker = match (markers, t.get(2)) {
-            (true, Some(m)) => lines.parse::<i32>(l, Some(m), "a facet marker")?,
-            _ => 0,
-        };
-        let mut facet = Facet {
-            marker,
-            ..Default::default()
-        };
-        for _ in 0..npoly {
-            let (l, t) = lines.next("a polygon")?;
-            let nc = lines.count(l, t.first().copied(), "the corner count")?;
-            if nc == 0 {
-                return Err(lines.error(l, "a polygon must have at least one corner"));
-            }
-            let (poly, _, _) = lines.indices(l, &t, 1, nc, base, np)?;
-            facet.polygons.push(poly);
-        }
-        for _ in 0..nholes {
-            let (l, t) = lines.next("a facet hole")?;
-            facet.holes.push(lines.point3(l, &t, 1)?);
-        }
-        plc.facets.push(facet);
-    }
+    let section = FacetSection {
+        count,
+        markers,
+        base,
+        n_points,
+    };
+    read_facets(&mut lines, &section, &mut plc)?;
     read_seeds(&mut lines, &mut plc)?;
     Ok(plc)
 }
 
+/// Reads a TetGen `.poly` file.
+pub fn read_poly(path: &Path) -> Result<Plc, IoError> {
+    read_plc_file(path, |lines, fs, plc| {
+        for _ in 0..fs.count {
+            let (l, t) = lines.next("a facet")?;
+            let npoly = lines.count(l, t.first().copied(), "the polygon count")?;
+            if npoly == 0 {
+                return Err(lines.error(l, "a facet must have at least one polygon"));
+            }
+            let nholes = match t.get(1) {
+                Some(x) => lines.count(l, Some(x), "the facet hole count")?,
+                None => 0,
+            };
+            let marker = match (fs.markers, t.get(2)) {
+                (true, Some(m)) => lines.parse::<i32>(l, Some(m), "a facet marker")?,
+                _ => 0,
+            };
+            let mut facet = Facet {
+                marker,
+                ..Default::default()
+            };
+            for _ in 0..npoly {
+                let (l, t) = lines.next("a polygon")?;
+                let nc = lines.count(l, t.first().copied(), "the corner count")?;
+                if nc == 0 {
+                    return Err(lines.error(l, "a polygon must have at least one corner"));
+                }
+                let (poly, _, _) = lines.indices(l, &t, 1, nc, fs.base, fs.n_points)?;
+                facet.polygons.push(poly);
+            }
+            for _ in 0..nholes {
+                let (l, t) = lines.next("a facet hole")?;
+                facet.holes.push(lines.point3(l, &t, 1)?);
+            }
+            plc.facets.push(facet);
+        }
+        Ok(())
+    })
+}
+
 /// Reads a TetGen `.smesh` file (one polygon per facet).
 pub fn read_smesh(path: &Path) -> Result<Plc, IoError> {
-    let bytes = read_bytes(path)?;
-    let text = as_text(path, &bytes)?;
-    let mut lines = Lines::new(path, text);
-    if lines.at_end() {
-        return Err(IoError::file(path, "empty file"));
-    }
-    let (points, base) = read_points(&mut lines, path)?;
-    let np = points.len();
-    let mut plc = Plc {
-        points,
-        ..Default::default()
-    };
-    let (l, h) = lines.next("the facet count")?;
-    let nf = lines.count(l, h.first().copied(), "the facet count")?;
-    let markers = match h.get(1) {
-        Some(m) => lines.parse::<i64>(l, Some(m), "the facet marker flag")? != 0,
-        None => false,
-    };
-    for _ in 0..nf {
-        let (l, t) = lines.next("a facet")?;
-        let nc = lines.count(l, t.first().copied(), "the corner count")?;
-        if nc == 0 {
-            return Err(lines.error(l, "a facet must have at least one corner"));
+    read_plc_file(path, |lines, fs, plc| {
+        for _ in 0..fs.count {
+            let (l, t) = lines.next("a facet")?;
+            let nc = lines.count(l, t.first().copied(), "the corner count")?;
+            if nc == 0 {
+                return Err(lines.error(l, "a facet must have at least one corner"));
+            }
+            let (poly, last_line, rest) = lines.indices(l, &t, 1, nc, fs.base, fs.n_points)?;
+            let marker = match (fs.markers, rest.first()) {
+                (true, Some(m)) => lines.parse::<i32>(last_line, Some(m), "a facet marker")?,
+                _ => 0,
+            };
+            plc.facets.push(Facet {
+                polygons: vec![poly],
+                holes: Vec::new(),
+                marker,
+            });
         }
-        let (poly, last_line, rest) = lines.indices(l, &t, 1, nc, base, np)?;
-        let marker = match (markers, rest.first()) {
-            (true, Some(m)) => lines.parse::<i32>(last_line, Some(m), "a facet marker")?,
-            _ => 0,
-        };
-        plc.facets.push(Facet {
-            polygons: vec![poly],
-            holes: Vec::new(),
-            marker,
-        });
-    }
-    read_seeds(&mut lines, &mut plc)?;
-    Ok(plc)
+        Ok(())
+    })
 }

@@ -967,19 +967,8 @@ fn read_piece_cell_array(
     out: &mut TetCellArray,
 ) -> Result<(), IoError> {
     let nc = count_attr(path, piece, "NumberOfCells")?;
-    let child = |e: &Element, child_name: &str| {
-        e.children
-            .iter()
-            .map(|&i| &elems[i])
-            .find(|c| c.name == child_name)
-    };
-    let arrays = |e: &Element| -> Vec<&Element> {
-        e.children
-            .iter()
-            .map(|&i| &elems[i])
-            .filter(|c| c.name == "DataArray")
-            .collect()
-    };
+    let child = |e: &Element, tag: &str| child_element(elems, e, tag);
+    let arrays = |e: &Element| data_arrays(elems, e);
     let at = |e: &Element, m: String| IoError::at(path, e.line, m);
     let cells = child(piece, "Cells").ok_or_else(|| at(piece, "<Piece> without <Cells>".into()))?;
     let typ_e = arrays(cells)
@@ -1054,6 +1043,23 @@ fn read_piece_cell_array(
     Ok(())
 }
 
+/// The first child of `e` with tag `tag`.
+fn child_element<'a>(elems: &'a [Element], e: &Element, tag: &str) -> Option<&'a Element> {
+    e.children
+        .iter()
+        .map(|&i| &elems[i])
+        .find(|c| c.name == tag)
+}
+
+/// The `<DataArray>` children of `e`.
+fn data_arrays<'a>(elems: &'a [Element], e: &Element) -> Vec<&'a Element> {
+    e.children
+        .iter()
+        .map(|&i| &elems[i])
+        .filter(|c| c.name == "DataArray")
+        .collect()
+}
+
 fn find(hay: &[u8], needle: &[u8]) -> Option<usize> {
     hay.windows(needle.len()).position(|w| w == needle)
 }
@@ -1078,19 +1084,8 @@ fn read_piece(
 ) -> Result<(), IoError> {
     let np = count_attr(path, piece, "NumberOfPoints")?;
     let nc = count_attr(path, piece, "NumberOfCells")?;
-    let child = |e: &Element, name: &str| {
-        e.children
-            .iter()
-            .map(|&i| &elems[i])
-            .find(|c| c.name == name)
-    };
-    let arrays = |e: &Element| -> Vec<&Element> {
-        e.children
-            .iter()
-            .map(|&i| &elems[i])
-            .filter(|c| c.name == "DataArray")
-            .collect()
-    };
+    let child = |e: &Element, tag: &str| child_element(elems, e, tag);
+    let arrays = |e: &Element| data_arrays(elems, e);
     let at = |e: &Element, m: String| IoError::at(path, e.line, m);
     let base = data.points.len() as i64;
 
