@@ -14,17 +14,24 @@ use crate::geom::{orient3d, tet_min_sine};
 use crate::mesh::TetMesh;
 use glam::DVec3;
 
+/// The corners of tet `t` with vertex `v` (if it is one of them) standing at `x`.
+#[inline]
+pub fn tet_points_with(mesh: &TetMesh, t: u32, v: u32, x: DVec3) -> [DVec3; 4] {
+    let tv = mesh.tet(t);
+    let mut p = mesh.tet_points(t);
+    for (pi, &vi) in p.iter_mut().zip(&tv) {
+        if vi == v {
+            *pi = x;
+        }
+    }
+    p
+}
+
 /// Smallest quality over the tets of `ball` if vertex `v` stood at `x`.
 pub fn ball_quality_at(mesh: &TetMesh, v: u32, ball: &[u32], x: DVec3) -> f64 {
     let mut q = f64::INFINITY;
     for &t in ball {
-        let tv = mesh.tet(t);
-        let mut p = mesh.tet_points(t);
-        for i in 0..4 {
-            if tv[i] == v {
-                p[i] = x;
-            }
-        }
+        let p = tet_points_with(mesh, t, v, x);
         q = q.min(tet_min_sine(&p));
     }
     q
@@ -35,13 +42,7 @@ pub fn ball_min_mean_at(mesh: &TetMesh, v: u32, ball: &[u32], x: DVec3) -> (f64,
     let mut q = f64::INFINITY;
     let mut sum = 0.0;
     for &t in ball {
-        let tv = mesh.tet(t);
-        let mut p = mesh.tet_points(t);
-        for i in 0..4 {
-            if tv[i] == v {
-                p[i] = x;
-            }
-        }
+        let p = tet_points_with(mesh, t, v, x);
         let s = tet_min_sine(&p);
         q = q.min(s);
         sum += s;
@@ -60,13 +61,7 @@ pub fn ball_quality(mesh: &TetMesh, ball: &[u32]) -> f64 {
 /// vertex `v` at `x`.
 pub fn ball_stays_positive(mesh: &TetMesh, v: u32, ball: &[u32], x: DVec3) -> bool {
     ball.iter().all(|&t| {
-        let tv = mesh.tet(t);
-        let mut p = mesh.tet_points(t);
-        for i in 0..4 {
-            if tv[i] == v {
-                p[i] = x;
-            }
-        }
+        let p = tet_points_with(mesh, t, v, x);
         orient3d(p[0], p[1], p[2], p[3]) > 0.0
     })
 }

@@ -38,13 +38,7 @@ impl Default for OptimizeParams {
 }
 
 fn tet_quality_with(mesh: &TetMesh, t: u32, v: u32, x: DVec3) -> f64 {
-    let tv = mesh.tet(t);
-    let mut p = mesh.tet_points(t);
-    for i in 0..4 {
-        if tv[i] == v {
-            p[i] = x;
-        }
-    }
+    let p = super::tet_points_with(mesh, t, v, x);
     tet_min_sine(&p)
 }
 
