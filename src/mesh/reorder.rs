@@ -26,7 +26,25 @@ impl TetMesh {
     /// position and tets by their smallest (new) vertex id. Returns the
     /// composite old → new maps. Tags, regions, levels and parents follow.
     pub fn reorder_spatially(&mut self) -> Remap {
+        self.reorder(true)
+            .expect("reorder(true) always returns the maps")
+    }
+
+    /// [`TetMesh::reorder_spatially`] without the old → new maps, for callers
+    /// that do not need them (the refinement step): on a 14M-tet mesh the
+    /// maps alone are 120 MB.
+    pub fn reorder_spatially_in_place(&mut self) {
+        self.reorder(false);
+    }
+
+    /// The reordering. Memory matters here: it runs on the largest mesh of a
+    /// refinement, so each array is permuted on its own and its old copy
+    /// dropped before the next one is built; at most 24 bytes per tet slot
+    /// are held on top of the mesh (the 4-byte order and map plus one
+    /// 16-byte array), where permuting everything at once took 53.
+    fn reorder(&mut self, want_maps: bool) -> Option<Remap> {
         let first = self.compact();
+        let first = want_maps.then_some(first);
         let np = self.points.len();
         if np == 0 {
             return first;
@@ -39,7 +57,7 @@ impl TetMesh {
             |(lo, hi), p| (lo.min(*p), hi.max(*p)),
         );
         let scale = (hi - lo).max_element().max(f64::MIN_POSITIVE);
-        let codes: Vec<(u64, u32)> = self
+        let mut codes: Vec<(u64, u32)> = self
             .points
             .par_iter()
             .enumerate()
@@ -49,40 +67,43 @@ impl TetMesh {
                 (c, i as u32)
             })
             .collect();
-        let mut order = codes;
-        order.par_sort_unstable();
+        codes.par_sort_unstable();
         let mut pmap = vec![0u32; np];
-        for (new, &(_, old)) in order.iter().enumerate() {
+        for (new, &(_, old)) in codes.iter().enumerate() {
             pmap[old as usize] = new as u32;
         }
-        let points: Vec<_> = order
-            .iter()
+        self.points = codes
+            .par_iter()
             .map(|&(_, old)| self.points[old as usize])
             .collect();
-        self.points = points;
+        drop(codes);
 
-        // Tets: renumber vertices, then sort by (smallest vertex, old id).
+        // Tets: renumber vertices, then sort by (smallest vertex, old id),
+        // packed in one u64 so that the sort key is 8 bytes.
         let nt = self.tets.len();
         self.tets.par_iter_mut().for_each(|v| {
             for x in v.iter_mut() {
                 *x = pmap[*x as usize];
             }
         });
-        let mut torder: Vec<(u32, u32)> = self
+        let mut keys: Vec<u64> = self
             .tets
             .par_iter()
             .enumerate()
-            .map(|(t, v)| (*v.iter().min().unwrap_or(&DEAD), t as u32))
+            .map(|(t, v)| (u64::from(*v.iter().min().unwrap_or(&DEAD)) << 32) | t as u64)
             .collect();
-        torder.par_sort_unstable();
+        keys.par_sort_unstable();
+        // `order[new] = old`, `tmap[old] = new`.
+        let order: Vec<u32> = keys.par_iter().map(|&k| k as u32).collect();
+        drop(keys);
         let mut tmap = vec![0u32; nt];
-        for (new, &(_, old)) in torder.iter().enumerate() {
+        for (new, &old) in order.iter().enumerate() {
             tmap[old as usize] = new as u32;
         }
-        let tets: Vec<[u32; 4]> = torder.iter().map(|&(_, o)| self.tets[o as usize]).collect();
-        let adj: Vec<[u32; 4]> = torder
+        self.tets = permuted(&self.tets, &order);
+        self.adj = order
             .par_iter()
-            .map(|&(_, o)| {
+            .map(|&o| {
                 self.adj[o as usize].map(|h| {
                     if h == NO_ADJ {
                         NO_ADJ
@@ -92,21 +113,11 @@ impl TetMesh {
                 })
             })
             .collect();
-        self.region = torder
-            .iter()
-            .map(|&(_, o)| self.region[o as usize])
-            .collect();
-        self.level = torder
-            .iter()
-            .map(|&(_, o)| self.level[o as usize])
-            .collect();
-        self.parent = torder
-            .iter()
-            .map(|&(_, o)| self.parent[o as usize])
-            .collect();
-        self.generation = vec![0; nt];
-        self.tets = tets;
-        self.adj = adj;
+        self.region = permuted(&self.region, &order);
+        self.level = permuted(&self.level, &order);
+        self.parent = permuted(&self.parent, &order);
+        drop(order);
+        self.generation.iter_mut().for_each(|g| *g = 0);
 
         let pm = |v: u32| pmap[v as usize];
         self.face_markers = self
@@ -128,11 +139,16 @@ impl TetMesh {
                 .map(|&x| if x == DEAD { DEAD } else { b[x as usize] })
                 .collect()
         };
-        Remap {
+        first.map(|first| Remap {
             points: compose(&first.points, &pmap),
             tets: compose(&first.tets, &tmap),
-        }
+        })
     }
+}
+
+/// `values` gathered in `order` (`out[new] = values[order[new]]`).
+fn permuted<T: Copy + Send + Sync>(values: &[T], order: &[u32]) -> Vec<T> {
+    order.par_iter().map(|&o| values[o as usize]).collect()
 }
 
 #[cfg(test)]
@@ -188,5 +204,28 @@ mod tests {
         let t0 = remap.tets[0];
         assert_eq!(m.region(t0), 5);
         assert_eq!(m.region(remap.tets[1]), 7);
+    }
+
+    #[test]
+    fn in_place_reordering_matches_the_mapped_one() {
+        // A grid with some tets killed and re-used, so compaction moves ids.
+        let (mut a, _) = TetMesh::from_data(&crate::mesh::generate::cube_grid(3)).unwrap();
+        let c = a.tet_points(5);
+        let centre = (c[0] + c[1] + c[2] + c[3]) * 0.25;
+        crate::ops::split14(&mut a, 5, centre).unwrap();
+        let mut b = a.clone();
+        let remap = a.reorder_spatially();
+        b.reorder_spatially_in_place();
+        assert_eq!(a.points, b.points);
+        assert_eq!(a.tets, b.tets);
+        assert_eq!(a.adj, b.adj);
+        assert_eq!(a.parent, b.parent);
+        b.check().unwrap();
+        // The maps send every live old tet to a distinct new slot.
+        let mut seen = vec![false; b.n_tet_slots()];
+        for &t in remap.tets.iter().filter(|&&t| t != DEAD) {
+            assert!(!std::mem::replace(&mut seen[t as usize], true));
+        }
+        assert!(seen.iter().all(|&s| s));
     }
 }

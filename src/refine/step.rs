@@ -96,7 +96,7 @@ pub fn refine_step_with_progress(
             Phase::Optimize => {
                 // The topological phases appended tets and points at the ends
                 // of the arrays; bring neighbours together in memory first.
-                mesh.reorder_spatially();
+                mesh.reorder_spatially_in_place();
                 if opts.opt_passes > 0 {
                     let (movable, tet_allowed) = if opts.smooth_refined_only {
                         refined_zone(mesh, step)
