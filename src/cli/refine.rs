@@ -195,22 +195,32 @@ pub fn run(a: Args) -> super::CliResult {
     crate::say!("{}", step_table_header());
     crate::say!("{}", step_row("input", &first, 0.0));
     let mut steps = vec![StepStats::input(first)];
-    let progress = BarProgress::new();
+    let phases_per_step = match a.stop_after {
+        Some(p) => Phase::ALL
+            .iter()
+            .position(|&q| q == p)
+            .map_or(Phase::ALL.len(), |i| i + 1),
+        None => Phase::ALL.len(),
+    };
+    let progress = BarProgress::new(a.steps, phases_per_step);
     for s in 1..=a.steps {
         if s > 1 && opts.selection.is_some() {
             opts.selection = Some(descendants_of_last_step(&mesh, s - 1));
         }
         let report = refine_step_with_progress(&mut mesh, s, &opts, &progress);
         let stats = MeshStats::compute(&mesh);
-        crate::say!("{}", step_row(&format!("step {s}"), &stats, report.seconds));
-        if report.refused_flips + report.refused_boundary_flips + report.skipped_moves > 0 {
-            eprintln!(
-                "note: step {s}: {} interior flips and {} boundary flips refused, {} boundary moves skipped (each would have inverted a tet)",
-                report.refused_flips, report.refused_boundary_flips, report.skipped_moves
-            );
-        }
+        progress.suspend(|| {
+            crate::say!("{}", step_row(&format!("step {s}"), &stats, report.seconds));
+            if report.refused_flips + report.refused_boundary_flips + report.skipped_moves > 0 {
+                eprintln!(
+                    "note: step {s}: {} interior flips and {} boundary flips refused, {} boundary moves skipped (each would have inverted a tet)",
+                    report.refused_flips, report.refused_boundary_flips, report.skipped_moves
+                );
+            }
+        });
         steps.push(StepStats::step(stats, &report));
     }
+    progress.finish();
     locate_parents(&input, &mut mesh);
     if let Some(path) = &a.stats {
         let text = serde_json::to_string_pretty(&StatsFile { steps: &steps })

@@ -22,10 +22,11 @@
 //! say) at the tetrahedra of a file, in the order [`read`] lists them.
 
 use super::{read_bytes, write_atomic, IoError};
-use crate::geom::tet_quality;
+use crate::geom::{tet_quality, tet_volume};
 use crate::mesh::{MeshData, TetMesh};
 use crate::report::MeshStats;
 use base64::Engine;
+use rayon::prelude::*;
 use std::io::{Read, Write};
 use std::path::Path;
 
@@ -99,71 +100,98 @@ fn xml_escape(s: &str) -> String {
         .replace('"', "&quot;")
 }
 
-/// The base64 text of a zlib-compressed array in VTK's block layout: the
-/// header `[blocks, block size, last block size, compressed sizes…]` (UInt64)
-/// and the concatenated compressed blocks, each encoded on its own.
-fn compressed_base64(raw: &[u8]) -> std::io::Result<String> {
-    let mut compressed = Vec::new();
-    let mut sizes = Vec::new();
-    for chunk in raw.chunks(BLOCK) {
-        let mut z = flate2::write::ZlibEncoder::new(Vec::new(), flate2::Compression::fast());
-        z.write_all(chunk)?;
-        let c = z.finish()?;
-        sizes.push(c.len() as u64);
-        compressed.extend_from_slice(&c);
-    }
-    let last = match raw.len() % BLOCK {
-        0 if raw.is_empty() => 0,
+/// Writes one zlib-compressed array in VTK's block layout: the base64 of the
+/// header `[blocks, block size, last block size, compressed sizes…]`
+/// (UInt64), then the base64 of the concatenated compressed blocks.
+///
+/// The values are `value(i)` for `i` in `0..n`, produced block by block, so
+/// the uncompressed array never exists as a whole: the blocks are filled and
+/// compressed in parallel (rayon; the output does not depend on the number of
+/// threads), and only the compressed array is held until its header, which
+/// needs every compressed size, has been written.
+fn compressed_array<T: LeBytes + Send>(
+    w: &mut dyn Write,
+    n: usize,
+    value: impl Fn(usize) -> T + Sync,
+) -> std::io::Result<()> {
+    let per_block = BLOCK / std::mem::size_of::<T>();
+    let blocks: Vec<Vec<u8>> = (0..n.div_ceil(per_block))
+        .into_par_iter()
+        .map(|b| {
+            let range = b * per_block..((b + 1) * per_block).min(n);
+            let mut raw = Vec::with_capacity(range.len() * std::mem::size_of::<T>());
+            for i in range {
+                value(i).put(&mut raw);
+            }
+            let mut z = flate2::write::ZlibEncoder::new(
+                Vec::with_capacity(raw.len() / 2),
+                flate2::Compression::fast(),
+            );
+            z.write_all(&raw)?;
+            z.finish()
+        })
+        .collect::<std::io::Result<_>>()?;
+    let raw_len = n * std::mem::size_of::<T>();
+    let last = match raw_len % BLOCK {
+        0 if raw_len == 0 => 0,
         0 => BLOCK,
         r => r,
     };
-    let mut header = Vec::with_capacity(8 * (3 + sizes.len()));
-    for v in [sizes.len() as u64, BLOCK as u64, last as u64]
+    let mut header = Vec::with_capacity(8 * (3 + blocks.len()));
+    for v in [blocks.len() as u64, BLOCK as u64, last as u64]
         .into_iter()
-        .chain(sizes.iter().copied())
+        .chain(blocks.iter().map(|c| c.len() as u64))
     {
         header.extend_from_slice(&v.to_le_bytes());
     }
     let b64 = base64::engine::general_purpose::STANDARD;
-    let mut s = b64.encode(&header);
-    s.push_str(&b64.encode(&compressed));
-    Ok(s)
+    w.write_all(b64.encode(&header).as_bytes())?;
+    let mut enc = base64::write::EncoderWriter::new(w, &b64);
+    for c in &blocks {
+        enc.write_all(c)?;
+    }
+    enc.finish()?;
+    Ok(())
 }
 
-fn data_array<T: LeBytes>(
+/// One `<DataArray>` element of `n` values `value(i)` (see [`compressed_array`]).
+fn data_array<T: LeBytes + Send>(
     w: &mut dyn Write,
     name: &str,
-    values: &[T],
+    n: usize,
     extra_attrs: &str,
+    value: impl Fn(usize) -> T + Sync,
 ) -> std::io::Result<()> {
-    let mut raw = Vec::with_capacity(std::mem::size_of_val(values));
-    for &v in values {
-        v.put(&mut raw);
-    }
     writeln!(
         w,
         "        <DataArray type=\"{}\" Name=\"{}\"{extra_attrs} format=\"binary\">",
         T::TYPE,
         xml_escape(name)
     )?;
-    writeln!(w, "          {}", compressed_base64(&raw)?)?;
-    writeln!(w, "        </DataArray>")
+    write!(w, "          ")?;
+    compressed_array(w, n, value)?;
+    writeln!(w, "\n        </DataArray>")
 }
 
 /// Writes `mesh` as a `.vtu` with the standard arrays and `extra_cells`
 /// (through a temporary file). Extra arrays need one value per live tet and a
 /// name different from the standard ones and from each other.
+///
+/// Memory: besides the mesh and the extra arrays, only the tet ids (when
+/// the mesh has dead slots), the point valences and one compressed array at
+/// a time are held; the per-tet quality arrays are computed block by block
+/// as they are compressed.
 pub fn write_vtu(path: &Path, mesh: &TetMesh, extra_cells: &[CellArray]) -> Result<(), IoError> {
-    let ids: Vec<u32> = mesh.tet_ids().collect();
+    let n_tets = mesh.n_tets();
     for (i, a) in extra_cells.iter().enumerate() {
-        if a.len() != ids.len() {
+        if a.len() != n_tets {
             return Err(IoError::file(
                 path,
                 format!(
                     "cell array '{}' has {} values for {} tetrahedra",
                     a.name(),
                     a.len(),
-                    ids.len()
+                    n_tets
                 ),
             ));
         }
@@ -176,30 +204,16 @@ pub fn write_vtu(path: &Path, mesh: &TetMesh, extra_cells: &[CellArray]) -> Resu
             ));
         }
     }
+    // The i-th live tet: slot i when the mesh is compact.
+    let ids: Option<Vec<u32>> = (mesh.n_tet_slots() != n_tets).then(|| mesh.tet_ids().collect());
+    let tet_at = |i: usize| match &ids {
+        Some(ids) => ids[i],
+        None => i as u32,
+    };
     let stats = MeshStats::compute(mesh);
-    let valence: Vec<i32> = MeshStats::vertex_valence(mesh)
-        .into_iter()
-        .map(|v| v as i32)
-        .collect();
-    let mut region = Vec::with_capacity(ids.len());
-    let mut min_dihedral = Vec::with_capacity(ids.len());
-    let mut max_dihedral = Vec::with_capacity(ids.len());
-    let mut quality = Vec::with_capacity(ids.len());
-    let mut volume = Vec::with_capacity(ids.len());
-    let mut connectivity = Vec::with_capacity(4 * ids.len());
-    for &t in &ids {
-        let q = tet_quality(&mesh.tet_points(t));
-        region.push(mesh.region(t));
-        min_dihedral.push(q.min_dihedral_deg);
-        max_dihedral.push(q.max_dihedral_deg);
-        quality.push(q.min_sine);
-        volume.push(q.volume);
-        connectivity.extend(mesh.tet(t).iter().map(|&v| v as i64));
-    }
-    let offsets: Vec<i64> = (1..=ids.len() as i64).map(|i| 4 * i).collect();
-    let types = vec![VTK_TETRA; ids.len()];
-    let points: Vec<f64> = mesh.points().iter().flat_map(|p| p.to_array()).collect();
-    let counts: Vec<i64> = stats.histogram.counts.iter().map(|&c| c as i64).collect();
+    let valence = MeshStats::vertex_valence(mesh);
+    let quality = |i: usize| tet_quality(&mesh.tet_points(tet_at(i)));
+    let counts = &stats.histogram.counts;
     let edges = &stats.histogram.edges_deg;
     write_atomic(path, |w| {
         writeln!(w, "<?xml version=\"1.0\"?>")?;
@@ -214,42 +228,58 @@ pub fn write_vtu(path: &Path, mesh: &TetMesh, extra_cells: &[CellArray]) -> Resu
         data_array(
             w,
             "histogram_counts",
-            &counts,
+            counts.len(),
             &format!(" NumberOfTuples=\"{}\"", counts.len()),
+            |i| counts[i] as i64,
         )?;
         data_array(
             w,
             "histogram_edges_deg",
-            edges,
+            edges.len(),
             &format!(" NumberOfTuples=\"{}\"", edges.len()),
+            |i| edges[i],
         )?;
         writeln!(w, "    </FieldData>")?;
         writeln!(
             w,
-            "    <Piece NumberOfPoints=\"{}\" NumberOfCells=\"{}\">",
+            "    <Piece NumberOfPoints=\"{}\" NumberOfCells=\"{n_tets}\">",
             mesh.n_points(),
-            ids.len()
         )?;
         writeln!(w, "      <PointData Scalars=\"valence\">")?;
-        data_array(w, "valence", &valence, "")?;
+        data_array(w, "valence", valence.len(), "", |i| valence[i] as i32)?;
         writeln!(w, "      </PointData>\n      <CellData Scalars=\"region\">")?;
-        data_array(w, "region", &region, "")?;
-        data_array(w, "min_dihedral", &min_dihedral, "")?;
-        data_array(w, "max_dihedral", &max_dihedral, "")?;
-        data_array(w, "quality", &quality, "")?;
-        data_array(w, "volume", &volume, "")?;
+        data_array(w, "region", n_tets, "", |i| mesh.region(tet_at(i)))?;
+        data_array(w, "min_dihedral", n_tets, "", |i| {
+            quality(i).min_dihedral_deg
+        })?;
+        data_array(w, "max_dihedral", n_tets, "", |i| {
+            quality(i).max_dihedral_deg
+        })?;
+        data_array(w, "quality", n_tets, "", |i| quality(i).min_sine)?;
+        data_array(w, "volume", n_tets, "", |i| {
+            tet_volume(&mesh.tet_points(tet_at(i)))
+        })?;
         for a in extra_cells {
             match a {
-                CellArray::Int32(n, v) => data_array(w, n, v, "")?,
-                CellArray::Float64(n, v) => data_array(w, n, v, "")?,
+                CellArray::Int32(n, v) => data_array(w, n, v.len(), "", |i| v[i])?,
+                CellArray::Float64(n, v) => data_array(w, n, v.len(), "", |i| v[i])?,
             }
         }
         writeln!(w, "      </CellData>\n      <Points>")?;
-        data_array(w, "Points", &points, " NumberOfComponents=\"3\"")?;
+        let points = mesh.points();
+        data_array(
+            w,
+            "Points",
+            3 * points.len(),
+            " NumberOfComponents=\"3\"",
+            |i| points[i / 3][i % 3],
+        )?;
         writeln!(w, "      </Points>\n      <Cells>")?;
-        data_array(w, "connectivity", &connectivity, "")?;
-        data_array(w, "offsets", &offsets, "")?;
-        data_array(w, "types", &types, "")?;
+        data_array(w, "connectivity", 4 * n_tets, "", |i| {
+            i64::from(mesh.tet(tet_at(i / 4))[i % 4])
+        })?;
+        data_array(w, "offsets", n_tets, "", |i| 4 * (i as i64 + 1))?;
+        data_array(w, "types", n_tets, "", |_| VTK_TETRA)?;
         writeln!(
             w,
             "      </Cells>\n    </Piece>\n  </UnstructuredGrid>\n</VTKFile>"
