@@ -455,6 +455,40 @@ impl TetMesh {
         self.v2t.reserve(p);
     }
 
+    /// Claims `n` tet slots for a bulk operation, in the order `n` calls of
+    /// [`TetMesh::alloc_tet`] would hand them out: first the free list from its
+    /// end, then new slots appended at the end of the arrays (reserved exactly,
+    /// without the doubling of `Vec` growth). Reused slots get their generation
+    /// bumped as `alloc_tet` does; every claimed slot holds a dead tet until
+    /// the caller fills it (vertices, adjacency, region, level, parent) — the
+    /// mesh is inconsistent until then.
+    pub(crate) fn claim_slots(&mut self, n: usize) -> NewSlots {
+        let r = n.min(self.free.len());
+        let reused: Vec<u32> = self.free.drain(self.free.len() - r..).rev().collect();
+        for &t in &reused {
+            let g = &mut self.generation[t as usize];
+            *g = g.wrapping_add(1);
+        }
+        let base = self.tets.len();
+        let len = base + (n - r);
+        self.tets.reserve_exact(n - r);
+        self.adj.reserve_exact(n - r);
+        self.generation.reserve_exact(n - r);
+        self.region.reserve_exact(n - r);
+        self.level.reserve_exact(n - r);
+        self.parent.reserve_exact(n - r);
+        self.tets.resize(len, [DEAD; 4]);
+        self.adj.resize(len, [NO_ADJ; 4]);
+        self.generation.resize(len, 0);
+        self.region.resize(len, 0);
+        self.level.resize(len, 0);
+        self.parent.resize(len, 0);
+        NewSlots {
+            reused,
+            base: base as u32,
+        }
+    }
+
     // ----- derived topology ----------------------------------------------------
 
     /// Local index of vertex `v` in tet `t`, if present.
@@ -585,6 +619,25 @@ impl TetMesh {
                     }
                 }
             }
+        }
+    }
+}
+
+/// Tet slots claimed by [`TetMesh::claim_slots`]: the `j`-th is
+/// [`NewSlots::get`]`(j)`.
+#[derive(Clone, Debug)]
+pub(crate) struct NewSlots {
+    reused: Vec<u32>,
+    base: u32,
+}
+
+impl NewSlots {
+    /// The `j`-th claimed slot.
+    #[inline]
+    pub(crate) fn get(&self, j: usize) -> u32 {
+        match self.reused.get(j) {
+            Some(&t) => t,
+            None => self.base + (j - self.reused.len()) as u32,
         }
     }
 }
