@@ -8,10 +8,7 @@
 use tetrefine::geom::{orient3d, TET_EDGES};
 use tetrefine::io::load_mesh;
 use tetrefine::mesh::generate::cube_grid;
-use tetrefine::ops::{
-    barycentre_flip_faces, flip23, flip23_bulk, flip23_valid, flip23_validity, flip32, split14,
-    split14_bulk,
-};
+use tetrefine::ops::{flip23, flip23_bulk, flip23_valid, flip32, split14, split14_bulk, FlipBatch};
 use tetrefine::TetMesh;
 
 /// The old split phase: `split14` on the selected tets in ascending order.
@@ -95,7 +92,7 @@ fn with_threads<R: Send>(n: usize, f: impl FnOnce() -> R + Send) -> R {
 fn compare(
     mesh: &TetMesh,
     sel: Option<&[bool]>,
-    refuse: impl Fn(usize) -> bool,
+    refuse: impl Fn(usize) -> bool + Sync,
 ) -> (usize, usize, usize) {
     let first = mesh.n_points() as u32;
     let vol0 = volume6(mesh);
@@ -112,22 +109,24 @@ fn compare(
         results.push(m);
     }
 
-    let faces = barycentre_flip_faces(&seq, first);
-    let valid = flip23_validity(&seq, &faces);
+    let batch = FlipBatch::barycentre_faces(&seq, first);
+    let faces = batch.faces();
     for (i, &(t, f)) in faces.iter().enumerate() {
-        assert_eq!(valid[i], flip23_valid(&seq, t, f));
+        assert_eq!(batch.is_valid(i), flip23_valid(&seq, t, f));
     }
-    let allowed: Vec<bool> = valid
-        .iter()
-        .enumerate()
-        .map(|(i, &v)| v && !refuse(i))
+    let allowed: Vec<bool> = (0..faces.len())
+        .map(|i| batch.is_valid(i) && !refuse(i))
         .collect();
     let f_seq = flip_one_by_one(&mut seq, &faces, &allowed);
     seq.check().unwrap();
     for (threads, mut m) in [1, 2].into_iter().zip(results) {
         let f = with_threads(threads, || {
-            assert_eq!(barycentre_flip_faces(&m, first), faces);
-            flip23_bulk(&mut m, &faces, &allowed)
+            let mut b = FlipBatch::barycentre_faces(&m, first);
+            assert_eq!(b.faces(), faces);
+            for i in (0..faces.len()).filter(|&i| refuse(i)) {
+                b.refuse(i);
+            }
+            flip23_bulk(&mut m, b)
         });
         assert_eq!(f, f_seq);
         m.check().unwrap();

@@ -455,6 +455,16 @@ impl TetMesh {
         self.v2t.reserve(p);
     }
 
+    /// Reserves room for exactly `n` more tet slots (no `Vec` doubling).
+    pub(crate) fn reserve_tets_exact(&mut self, n: usize) {
+        self.tets.reserve_exact(n);
+        self.adj.reserve_exact(n);
+        self.generation.reserve_exact(n);
+        self.region.reserve_exact(n);
+        self.level.reserve_exact(n);
+        self.parent.reserve_exact(n);
+    }
+
     /// Claims `n` tet slots for a bulk operation, in the order `n` calls of
     /// [`TetMesh::alloc_tet`] would hand them out: first the free list from its
     /// end, then new slots appended at the end of the arrays (reserved exactly,
@@ -471,12 +481,7 @@ impl TetMesh {
         }
         let base = self.tets.len();
         let len = base + (n - r);
-        self.tets.reserve_exact(n - r);
-        self.adj.reserve_exact(n - r);
-        self.generation.reserve_exact(n - r);
-        self.region.reserve_exact(n - r);
-        self.level.reserve_exact(n - r);
-        self.parent.reserve_exact(n - r);
+        self.reserve_tets_exact(n - r);
         self.tets.resize(len, [DEAD; 4]);
         self.adj.resize(len, [NO_ADJ; 4]);
         self.generation.resize(len, 0);

@@ -29,65 +29,48 @@
 //! slots, generations and vertex → tet entries). Seed paper §3.1 (Figure 5).
 
 use super::bulk::{Disjoint, LastTouch};
-use super::{all_positive, flip23_tets, is_constrained_face};
-use crate::geom::TET_FACES;
+use super::is_constrained_face;
+use crate::geom::{orient3d, TET_FACES};
 use crate::mesh::{TetMesh, DEAD, NO_ADJ};
+use glam::DVec3;
 use rayon::prelude::*;
 
 const NONE: u32 = u32::MAX;
 
-/// The faces of the √3 flip phase: for each child of a split of this step (it
-/// has exactly one vertex at or above `first_barycentre`, the barycentre) the
-/// old face opposite that vertex when the tet across it is a child too and
-/// the face is not constrained ([`is_constrained_face`]). Each face once, as
-/// `(t, f)` with `t` the lower slot, in ascending `t`.
-pub fn barycentre_flip_faces(mesh: &TetMesh, first_barycentre: u32) -> Vec<(u32, usize)> {
-    let first = first_barycentre;
-    let tets = &mesh.tets;
-    (0..tets.len() as u32)
-        .into_par_iter()
-        .filter_map(|t| {
-            let v = tets[t as usize];
-            if v[0] == DEAD {
-                return None;
-            }
-            let mut bary = (0..4).filter(|&j| v[j] >= first);
-            let i = bary.next()?;
-            if bary.next().is_some() {
-                return None;
-            }
-            let h = mesh.adj[t as usize][i];
-            if h == NO_ADJ {
-                return None;
-            }
-            let (u, g) = TetMesh::half_face(h);
-            (u > t && tets[u as usize][g] >= first && !is_constrained_face(mesh, t, i))
-                .then_some((t, i))
-        })
-        .collect()
-}
-
-/// Per face `(t, f)`: would its 2-3 flip create three positive tets (exact
-/// predicate, as [`super::flip23_valid`])? Computed in parallel.
-pub fn flip23_validity(mesh: &TetMesh, faces: &[(u32, usize)]) -> Vec<bool> {
-    faces
-        .par_iter()
-        .map(|&(t, f)| flip23_tets(mesh, t, f).is_some_and(|n| all_positive(mesh, &n)))
-        .collect()
-}
-
-/// One flip of the bulk: slots of the two old tets and of the third new tet,
-/// and `f | ia << 2 | ib << 4 | ic << 6` — the local index of the face in `t`
-/// and the local indices of its vertices a, b, c in `u`.
-#[derive(Clone, Copy)]
+/// One flip of a batch: slots of the two old tets and of the third new tet
+/// (set when the batch is applied), `f | ia << 2 | ib << 4 | ic << 6` — the
+/// local index of the face in `t` and the local indices of its vertices a,
+/// b, c in `u` — and whether the flip is to be done.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
 struct Flip {
     t: u32,
     u: u32,
     s: u32,
     code: u8,
+    ok: bool,
 }
 
 impl Flip {
+    /// The flip of face `f` of `t` (interior; `u` is across it).
+    #[inline]
+    fn new(tets: &[[u32; 4]], t: u32, f: usize, u: u32) -> Flip {
+        let (vt, vu) = (tets[t as usize], tets[u as usize]);
+        let l = TET_FACES[f];
+        let mut code = f as u8;
+        for (s, &i) in l.iter().enumerate() {
+            let x = vt[i];
+            let j = (0..4).find(|&j| vu[j] == x).unwrap_or(0);
+            code |= (j as u8) << (2 + 2 * s);
+        }
+        Flip {
+            t,
+            u,
+            s: 0,
+            code,
+            ok: false,
+        }
+    }
+
     #[inline]
     fn f(self) -> usize {
         (self.code & 3) as usize
@@ -97,6 +80,26 @@ impl Flip {
     #[inline]
     fn in_u(self) -> [usize; 3] {
         [2, 4, 6].map(|s| ((self.code >> s) & 3) as usize)
+    }
+
+    /// The three new tets N0, N1, N2 over the current vertices of t and u.
+    #[inline]
+    fn new_tets(self, vt: [u32; 4], vu: [u32; 4]) -> [[u32; 4]; 3] {
+        let l = TET_FACES[self.f()];
+        let [a, b, c] = [vt[l[0]], vt[l[1]], vt[l[2]]];
+        let [ia, ib, ic] = self.in_u();
+        let (p, q) = (vt[self.f()], vu[6 - ia - ib - ic]);
+        [[a, b, p, q], [b, c, p, q], [c, a, p, q]]
+    }
+
+    /// Whether the three new tets are positive (exact predicate).
+    #[inline]
+    fn positive(self, tets: &[[u32; 4]], points: &[DVec3]) -> bool {
+        let n = self.new_tets(tets[self.t as usize], tets[self.u as usize]);
+        n.iter().all(|v| {
+            let p = v.map(|x| points[x as usize]);
+            orient3d(p[0], p[1], p[2], p[3]) > 0.0
+        })
     }
 
     /// The new half-face that outer face `m` (local index in `t` when `side`
@@ -124,54 +127,119 @@ impl Flip {
     }
 }
 
-/// 2-3 flips the faces `faces` (interior faces `(t, f)`, pairwise disjoint
-/// pairs of tets, as [`barycentre_flip_faces`] gives) whose `valid` entry is
-/// true, all at once; a face between two regions or carrying a marker is
-/// refused, as [`super::flip23`] does. Every new tet was found positive by the
-/// caller's `valid` (from [`flip23_validity`] on the current points).
-/// Returns the number of faces flipped.
-pub fn flip23_bulk(mesh: &mut TetMesh, faces: &[(u32, usize)], valid: &[bool]) -> usize {
-    assert_eq!(faces.len(), valid.len());
-    let mut flips: Vec<Flip> = faces
-        .par_iter()
-        .zip(valid)
-        .filter_map(|(&(t, f), &ok)| {
-            let h = mesh.adj[t as usize][f];
-            if !ok || h == NO_ADJ {
-                return None;
-            }
-            let u = h >> 2;
-            if mesh.region[t as usize] != mesh.region[u as usize]
-                || (!mesh.face_markers.is_empty()
-                    && mesh.face_marker(mesh.face_vertices(t, f)).is_some())
-            {
-                return None;
-            }
-            let vu = mesh.tets[u as usize];
-            let mut code = f as u8;
-            for (s, x) in mesh.face_vertices(t, f).into_iter().enumerate() {
-                let i = vu.iter().position(|&y| y == x)?;
-                code |= (i as u8) << (2 + 2 * s);
-            }
-            Some(Flip { t, u, s: 0, code })
-        })
-        .collect();
+/// The 2-3 flips of one √3 step, found and judged in one parallel pass over
+/// the tets by [`FlipBatch::barycentre_faces`], applied by [`flip23_bulk`].
+#[derive(Clone, Debug, Default)]
+pub struct FlipBatch {
+    flips: Vec<Flip>,
+}
+
+impl FlipBatch {
+    /// The faces of the √3 flip phase: for each child of a split of this step
+    /// (it has exactly one vertex at or above `first_barycentre`, the
+    /// barycentre) the old face opposite that vertex when the tet across it
+    /// is a child too and the face is not constrained
+    /// ([`is_constrained_face`]). Each face once, as `(t, f)` with `t` the
+    /// lower slot, in ascending `t`; each flip is marked valid when its three
+    /// new tets are positive (exact predicate, as [`super::flip23_valid`]).
+    pub fn barycentre_faces(mesh: &TetMesh, first_barycentre: u32) -> FlipBatch {
+        let first = first_barycentre;
+        let (tets, points) = (&mesh.tets, &mesh.points);
+        let flips = (0..tets.len() as u32)
+            .into_par_iter()
+            .filter_map(|t| {
+                let v = tets[t as usize];
+                if v[0] == DEAD {
+                    return None;
+                }
+                let mut bary = (0..4).filter(|&j| v[j] >= first);
+                let i = bary.next()?;
+                if bary.next().is_some() {
+                    return None;
+                }
+                let h = mesh.adj[t as usize][i];
+                if h == NO_ADJ {
+                    return None;
+                }
+                let (u, g) = TetMesh::half_face(h);
+                if u < t || tets[u as usize][g] < first || is_constrained_face(mesh, t, i) {
+                    return None;
+                }
+                let mut fl = Flip::new(tets, t, i, u);
+                fl.ok = fl.positive(tets, points);
+                Some(fl)
+            })
+            .collect();
+        FlipBatch { flips }
+    }
+
+    /// Number of faces.
+    pub fn len(&self) -> usize {
+        self.flips.len()
+    }
+
+    /// Whether there is no face.
+    pub fn is_empty(&self) -> bool {
+        self.flips.is_empty()
+    }
+
+    /// The faces `(t, f)`, in order.
+    pub fn faces(&self) -> Vec<(u32, usize)> {
+        self.flips.iter().map(|fl| (fl.t, fl.f())).collect()
+    }
+
+    /// Whether face `i` will be flipped.
+    pub fn is_valid(&self, i: usize) -> bool {
+        self.flips[i].ok
+    }
+
+    /// Number of faces that will be flipped.
+    pub fn valid_count(&self) -> usize {
+        self.flips.par_iter().filter(|fl| fl.ok).count()
+    }
+
+    /// The faces whose flip would not give three positive tets.
+    pub fn invalid_faces(&self) -> Vec<(u32, usize)> {
+        self.flips
+            .par_iter()
+            .filter(|fl| !fl.ok)
+            .map(|fl| (fl.t, fl.f()))
+            .collect()
+    }
+
+    /// Judges every flip again on the current points (after some moved).
+    pub fn revalidate(&mut self, mesh: &TetMesh) {
+        let (tets, points) = (&mesh.tets, &mesh.points);
+        self.flips
+            .par_iter_mut()
+            .for_each(|fl| fl.ok = fl.positive(tets, points));
+    }
+
+    /// Refuses flip `i` (it will not be done).
+    pub fn refuse(&mut self, i: usize) {
+        self.flips[i].ok = false;
+    }
+}
+
+/// 2-3 flips all valid faces of `batch` at once (made by
+/// [`FlipBatch::barycentre_faces`] on this mesh, unchanged since but for
+/// moved points and a [`FlipBatch::revalidate`]). Returns the number of
+/// faces flipped.
+pub fn flip23_bulk(mesh: &mut TetMesh, batch: FlipBatch) -> usize {
+    let mut flips = batch.flips;
+    flips.retain(|fl| fl.ok);
     let k = flips.len();
     if k == 0 {
         return 0;
     }
     let n = mesh.tets.len();
     let slots = mesh.claim_slots(k);
-    flips
-        .par_iter_mut()
-        .enumerate()
-        .for_each(|(i, fl)| fl.s = slots.get(i));
-
     // Per old slot: 2k for the t of flip k, 2k+1 for its u.
     let mut role = vec![NONE; n];
     {
         let r = Disjoint::new(&mut role);
-        flips.par_iter().enumerate().for_each(|(i, fl)| {
+        flips.par_iter_mut().enumerate().for_each(|(i, fl)| {
+            fl.s = slots.get(i);
             // SAFETY: the pairs are disjoint, so each slot has one writer.
             unsafe {
                 r.write(fl.t as usize, 2 * i as u32);
@@ -179,6 +247,7 @@ pub fn flip23_bulk(mesh: &mut TetMesh, faces: &[(u32, usize)], valid: &[bool]) -
             }
         });
     }
+    let last = LastTouch::new(mesh.points.len());
 
     {
         let tets = Disjoint::new(&mut mesh.tets);
@@ -187,8 +256,9 @@ pub fn flip23_bulk(mesh: &mut TetMesh, faces: &[(u32, usize)], valid: &[bool]) -
         let region = Disjoint::new(&mut mesh.region);
         let level = Disjoint::new(&mut mesh.level);
         let parent = Disjoint::new(&mut mesh.parent);
-        let (role, flips) = (&role, &flips);
-        flips.par_iter().for_each(|&fl| {
+        let (role, flips, last) = (&role, &flips, &last);
+        // Descending, so that most `LastTouch` records are no-ops.
+        flips.par_iter().enumerate().rev().for_each(|(i, &fl)| {
             let (t, u, s) = (fl.t as usize, fl.u as usize, fl.s as usize);
             // SAFETY: this task alone reads and writes slots t, u and s (the
             // pairs are disjoint, s was claimed for this flip only); the lane
@@ -202,6 +272,9 @@ pub fn flip23_bulk(mesh: &mut TetMesh, faces: &[(u32, usize)], valid: &[bool]) -
                 let [ia, ib, ic] = fl.in_u();
                 let p = vt[fl.f()];
                 let q = vu[6 - ia - ib - ic];
+                for x in [a, b, c, p, q] {
+                    last.touch(x, i);
+                }
                 // The outer half-face across local face m of t (side 0) or u
                 // (side 1), which becomes `dest`.
                 let outer = |side: u32, m: usize, dest: u32| {
@@ -261,15 +334,7 @@ pub fn flip23_bulk(mesh: &mut TetMesh, faces: &[(u32, usize)], valid: &[bool]) -
 
     // Vertex → tet: flip k allocated N0, N1, N2 in this order, so its last
     // tet over b is N1 (slot t) and over a, c, p, q it is N2 (slot s).
-    let last = LastTouch::new(mesh.points.len());
     let tets = &mesh.tets;
-    flips.par_iter().enumerate().for_each(|(i, fl)| {
-        let [b, c, p, q] = tets[fl.t as usize];
-        let a = tets[fl.u as usize][0];
-        for x in [a, b, c, p, q] {
-            last.touch(x, i);
-        }
-    });
     mesh.v2t.par_iter_mut().enumerate().for_each(|(x, e)| {
         if let Some(i) = last.get(x) {
             let fl = flips[i];

@@ -59,6 +59,10 @@ fn children_positive(points: &[DVec3], v: [u32; 4], c: DVec3) -> bool {
 /// its barycentre, raising the children's `level` by one (saturating) and
 /// keeping region and parent. A split that would create a non-positive child
 /// is refused and the tet stays. Returns the number of tets split.
+///
+/// The tet arrays are reserved exactly for the children plus one tet per face
+/// between two split tets, the 2-3 flips that follow in a √3 step, so that
+/// neither phase reallocates them again.
 pub fn split14_bulk(mesh: &mut TetMesh, selection: Option<&[bool]>) -> usize {
     let n = mesh.tets.len();
     let np0 = mesh.points.len();
@@ -99,6 +103,21 @@ pub fn split14_bulk(mesh: &mut TetMesh, selection: Option<&[bool]>) -> usize {
             .collect();
         points.extend_from_slice(&new);
     }
+    // Room for the children and for one tet per face between two split tets:
+    // the 2-3 flips that follow in a √3 step then need no reallocation.
+    let shared_faces: usize = {
+        let (adj, number) = (&mesh.adj, &number);
+        ids.par_iter()
+            .map(|&t| {
+                adj[t as usize]
+                    .iter()
+                    .filter(|&&h| h != NO_ADJ && (h >> 2) > t && number[(h >> 2) as usize] != NONE)
+                    .count()
+            })
+            .sum()
+    };
+    let free = mesh.free.len();
+    mesh.reserve_tets_exact((3 * k + shared_faces).saturating_sub(free));
     let slots = mesh.claim_slots(3 * k);
     let child_slot = |t: u32, i: usize, j: usize| {
         if j == 0 {

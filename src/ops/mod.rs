@@ -21,7 +21,7 @@ pub mod trisect;
 use crate::geom::{orient3d, TET_FACES};
 use crate::mesh::{face_key, FaceKey, TetMesh, NO_ADJ};
 
-pub use bulk_flip::{barycentre_flip_faces, flip23_bulk, flip23_validity};
+pub use bulk_flip::{flip23_bulk, FlipBatch};
 pub use bulk_split::split14_bulk;
 pub use edge_removal::{remove_edge, EdgeRing};
 pub use flip23::{flip23, flip23_tets, flip23_valid};

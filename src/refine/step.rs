@@ -5,9 +5,8 @@ use crate::geom::TET_EDGES;
 use crate::mesh::fasthash::FastHashMap;
 use crate::mesh::{edge_key, TetMarks, TetMesh};
 use crate::ops::{
-    barycentre_flip_faces, flip23_bulk, flip23_valid, flip23_validity, is_constrained_face,
-    remove_edge, remove_interface_edge, split14_bulk, split_boundary_face, split_interface_face,
-    trisect_edge, EdgeRing,
+    flip23_bulk, flip23_valid, is_constrained_face, remove_edge, remove_interface_edge,
+    split14_bulk, split_boundary_face, split_interface_face, trisect_edge, EdgeRing, FlipBatch,
 };
 use crate::smooth::{ball_stays_positive, improve, ImproveOptions};
 use crate::surface::sqrt3::sqrt3_positions_trisecting;
@@ -165,14 +164,15 @@ fn split_phase(mesh: &mut TetMesh, opts: &RefineOptions, report: &mut StepReport
 /// ([`flip23_bulk`]).
 fn flip_phase(mesh: &mut TetMesh, st: &StepState, report: &mut StepReport) {
     let first = st.first_barycentre;
-    let faces = barycentre_flip_faces(mesh, first);
-    let mut valid = flip23_validity(mesh, &faces);
-    if make_flips_valid(mesh, first, &faces, &valid, report) {
-        valid = flip23_validity(mesh, &faces);
+    let mut batch = FlipBatch::barycentre_faces(mesh, first);
+    let invalid = batch.invalid_faces();
+    if !invalid.is_empty() && make_flips_valid(mesh, first, &batch.faces(), &invalid, report) {
+        batch.revalidate(mesh);
     }
-    let flipped = flip23_bulk(mesh, &faces, &valid);
+    let n = batch.len();
+    let flipped = flip23_bulk(mesh, batch);
     report.flipped += flipped;
-    report.refused_flips += faces.len() - flipped;
+    report.refused_flips += n - flipped;
 }
 
 /// Where the segment between two barycentres misses their shared face (the
@@ -181,22 +181,14 @@ fn flip_phase(mesh: &mut TetMesh, st: &StepState, report: &mut StepReport) {
 /// inside their parents, so the children stay valid — as long as no other
 /// flip of theirs that was valid becomes invalid. The optimize phase moves
 /// these points again later. Counted in `StepReport::moved_barycentres`.
+/// Returns whether any point moved.
 fn make_flips_valid(
     mesh: &mut TetMesh,
     first: u32,
     faces: &[(u32, usize)],
-    valid: &[bool],
+    invalid: &[(u32, usize)],
     report: &mut StepReport,
 ) -> bool {
-    let invalid: Vec<(u32, usize)> = faces
-        .iter()
-        .zip(valid)
-        .filter(|&(_, &ok)| !ok)
-        .map(|(&x, _)| x)
-        .collect();
-    if invalid.is_empty() {
-        return false;
-    }
     let mut moved = false;
     // The flip faces around each barycentre, to re-check its other flips.
     let mut around: HashMap<u32, Vec<(u32, usize)>> = HashMap::new();
@@ -209,7 +201,7 @@ fn make_flips_valid(
         around.entry(q).or_default().push((t, f));
     }
     let mut ball = Vec::new();
-    for (t, f) in invalid {
+    for &(t, f) in invalid {
         let h = mesh.adj(t)[f];
         let (u, g) = TetMesh::half_face(h);
         let (p, q) = (mesh.tet(t)[f], mesh.tet(u)[g]);
