@@ -29,6 +29,7 @@ pub use data::MeshData;
 
 use crate::geom::{TET_EDGES, TET_EDGE_OPPOSITE, TET_FACES};
 use glam::DVec3;
+use rayon::prelude::*;
 use std::collections::{HashMap, HashSet};
 
 /// Adjacency value of a boundary face.
@@ -482,12 +483,17 @@ impl TetMesh {
         let base = self.tets.len();
         let len = base + (n - r);
         self.reserve_tets_exact(n - r);
-        self.tets.resize(len, [DEAD; 4]);
-        self.adj.resize(len, [NO_ADJ; 4]);
-        self.generation.resize(len, 0);
-        self.region.resize(len, 0);
-        self.level.resize(len, 0);
-        self.parent.resize(len, 0);
+        // Filled in parallel so that both threads take the page faults of
+        // fresh memory.
+        let extra = len - base;
+        self.tets
+            .par_extend(rayon::iter::repeat_n([DEAD; 4], extra));
+        self.adj
+            .par_extend(rayon::iter::repeat_n([NO_ADJ; 4], extra));
+        self.generation.par_extend(rayon::iter::repeat_n(0, extra));
+        self.region.par_extend(rayon::iter::repeat_n(0, extra));
+        self.level.par_extend(rayon::iter::repeat_n(0, extra));
+        self.parent.par_extend(rayon::iter::repeat_n(0, extra));
         NewSlots {
             reused,
             base: base as u32,
