@@ -2,8 +2,8 @@
 //! operations applied one by one: the bulk result must be the same mesh, slot
 //! for slot (vertices, adjacency, generation, region, level, parent, points,
 //! vertex → tet), and equal for one and two threads. Inputs: the tripod, a
-//! seeded jittered cube with free slots, an adaptive selection, and flips
-//! refused on purpose.
+//! seeded jittered cube with free slots, an adaptive selection, flips
+//! refused on purpose, and the flip phase repairing an invalid flip first.
 
 use tetrefine::geom::{orient3d, TET_EDGES};
 use tetrefine::io::load_mesh;
@@ -245,4 +245,50 @@ fn bulk_equals_one_by_one_with_refused_flips() {
     // re-linked to the refused tets, not to flipped ones.
     let (_, flipped, faces) = compare(&mesh, None, |i| i % 3 == 0);
     assert!(flipped < faces && flipped > 0);
+}
+
+/// Two tets on the face (0,0,0) (1,0,0) (0,1,0), one with its apex far out
+/// at (5,5,1): the segment between the barycentres (1.5,1.5,0.25) and
+/// (0.275,0.275,-0.25) crosses the face's plane at (0.8875,0.8875,0), outside
+/// the face, so the flip is invalid as split. The flip phase pulls both
+/// barycentres towards the face's centroid (a factor 0.15 brings the crossing
+/// inside, x + y < 1) and then flips in bulk: 8 children + 1 = 9 tets.
+#[test]
+fn the_flip_phase_repairs_an_invalid_flip_and_then_flips_in_bulk() {
+    use tetrefine::mesh::MeshData;
+    use tetrefine::refine::{refine_step, Phase, RefineOptions};
+    let data = MeshData {
+        points: vec![
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [5.0, 5.0, 1.0],
+            [0.1, 0.1, -1.0],
+        ],
+        tets: vec![[0, 1, 2, 3], [0, 2, 1, 4]],
+        ..Default::default()
+    };
+    let (mut mesh, _) = TetMesh::from_data(&data).unwrap();
+    let first = mesh.n_points() as u32;
+    let mut split = mesh.clone();
+    split14_bulk(&mut split, None);
+    let batch = FlipBatch::barycentre_faces(&split, first);
+    assert_eq!(batch.len(), 1);
+    assert!(!batch.is_valid(0));
+    let vol0 = volume6(&mesh);
+    let r = refine_step(
+        &mut mesh,
+        1,
+        &RefineOptions {
+            stop_after: Some(Phase::Flip),
+            check_each_phase: true,
+            ..Default::default()
+        },
+    );
+    assert!(r.check_failures.is_empty(), "{:?}", r.check_failures);
+    assert_eq!(r.split, 2);
+    assert_eq!(r.moved_barycentres, 2);
+    assert_eq!((r.flipped, r.refused_flips), (1, 0));
+    assert_eq!(mesh.n_tets(), 9);
+    assert!((volume6(&mesh) - vol0).abs() <= 1e-12 * vol0);
 }
