@@ -29,6 +29,7 @@ pub use data::MeshData;
 
 use crate::geom::{TET_EDGES, TET_EDGE_OPPOSITE, TET_FACES};
 use glam::DVec3;
+use rayon::prelude::*;
 use std::collections::{HashMap, HashSet};
 
 /// Adjacency value of a boundary face.
@@ -455,6 +456,50 @@ impl TetMesh {
         self.v2t.reserve(p);
     }
 
+    /// Reserves room for exactly `n` more tet slots (no `Vec` doubling).
+    pub(crate) fn reserve_tets_exact(&mut self, n: usize) {
+        self.tets.reserve_exact(n);
+        self.adj.reserve_exact(n);
+        self.generation.reserve_exact(n);
+        self.region.reserve_exact(n);
+        self.level.reserve_exact(n);
+        self.parent.reserve_exact(n);
+    }
+
+    /// Claims `n` tet slots for a bulk operation, in the order `n` calls of
+    /// [`TetMesh::alloc_tet`] would hand them out: first the free list from its
+    /// end, then new slots appended at the end of the arrays (reserved exactly,
+    /// without the doubling of `Vec` growth). Reused slots get their generation
+    /// bumped as `alloc_tet` does; every claimed slot holds a dead tet until
+    /// the caller fills it (vertices, adjacency, region, level, parent) — the
+    /// mesh is inconsistent until then.
+    pub(crate) fn claim_slots(&mut self, n: usize) -> NewSlots {
+        let r = n.min(self.free.len());
+        let reused: Vec<u32> = self.free.drain(self.free.len() - r..).rev().collect();
+        for &t in &reused {
+            let g = &mut self.generation[t as usize];
+            *g = g.wrapping_add(1);
+        }
+        let base = self.tets.len();
+        let len = base + (n - r);
+        self.reserve_tets_exact(n - r);
+        // Filled in parallel so that both threads take the page faults of
+        // fresh memory.
+        let extra = len - base;
+        self.tets
+            .par_extend(rayon::iter::repeat_n([DEAD; 4], extra));
+        self.adj
+            .par_extend(rayon::iter::repeat_n([NO_ADJ; 4], extra));
+        self.generation.par_extend(rayon::iter::repeat_n(0, extra));
+        self.region.par_extend(rayon::iter::repeat_n(0, extra));
+        self.level.par_extend(rayon::iter::repeat_n(0, extra));
+        self.parent.par_extend(rayon::iter::repeat_n(0, extra));
+        NewSlots {
+            reused,
+            base: base as u32,
+        }
+    }
+
     // ----- derived topology ----------------------------------------------------
 
     /// Local index of vertex `v` in tet `t`, if present.
@@ -585,6 +630,25 @@ impl TetMesh {
                     }
                 }
             }
+        }
+    }
+}
+
+/// Tet slots claimed by [`TetMesh::claim_slots`]: the `j`-th is
+/// [`NewSlots::get`]`(j)`.
+#[derive(Clone, Debug)]
+pub(crate) struct NewSlots {
+    reused: Vec<u32>,
+    base: u32,
+}
+
+impl NewSlots {
+    /// The `j`-th claimed slot.
+    #[inline]
+    pub(crate) fn get(&self, j: usize) -> u32 {
+        match self.reused.get(j) {
+            Some(&t) => t,
+            None => self.base + (j - self.reused.len()) as u32,
         }
     }
 }

@@ -7,6 +7,9 @@
 //! flat tet returns [`OpError::WouldInvert`] and leaves the mesh untouched.
 //! The shared re-linking lives here in [`replace_cavity`].
 
+mod bulk;
+pub mod bulk_flip;
+pub mod bulk_split;
 pub mod edge_removal;
 pub mod flip23;
 pub mod flip32;
@@ -18,6 +21,8 @@ pub mod trisect;
 use crate::geom::{orient3d, TET_FACES};
 use crate::mesh::{face_key, FaceKey, TetMesh, NO_ADJ};
 
+pub use bulk_flip::{flip23_bulk, FlipBatch};
+pub use bulk_split::split14_bulk;
 pub use edge_removal::{remove_edge, EdgeRing};
 pub use flip23::{flip23, flip23_tets, flip23_valid};
 pub use flip32::flip32;
@@ -47,6 +52,16 @@ pub fn all_positive(mesh: &TetMesh, tets: &[[u32; 4]]) -> bool {
         let p = v.map(|x| mesh.point(x));
         orient3d(p[0], p[1], p[2], p[3]) > 0.0
     })
+}
+
+/// Whether interior face `f` of `t` must survive like the boundary: it
+/// separates two regions or carries a marker. (False for boundary faces.)
+pub fn is_constrained_face(mesh: &TetMesh, t: u32, f: usize) -> bool {
+    let h = mesh.adj(t)[f];
+    h != NO_ADJ
+        && (mesh.region(h >> 2) != mesh.region(t)
+            || (!mesh.face_markers().is_empty()
+                && mesh.face_marker(mesh.face_vertices(t, f)).is_some()))
 }
 
 /// Replaces the tets `old` by the tets `new`, re-using slots and re-linking

@@ -3,10 +3,10 @@
 use super::{NoProgress, Phase, PhaseReport, Progress, RefineOptions, StepReport};
 use crate::geom::TET_EDGES;
 use crate::mesh::fasthash::FastHashMap;
-use crate::mesh::{edge_key, TetMarks, TetMesh, NO_ADJ};
+use crate::mesh::{edge_key, TetMarks, TetMesh};
 use crate::ops::{
-    flip23, flip23_valid, remove_edge, remove_interface_edge, split14, split_boundary_face,
-    split_interface_face, trisect_edge, EdgeRing,
+    flip23_bulk, flip23_valid, is_constrained_face, remove_edge, remove_interface_edge,
+    split14_bulk, split_boundary_face, split_interface_face, trisect_edge, EdgeRing, FlipBatch,
 };
 use crate::smooth::{ball_stays_positive, improve, ImproveOptions};
 use crate::surface::sqrt3::sqrt3_positions_trisecting;
@@ -151,62 +151,28 @@ fn refined_zone(mesh: &TetMesh, step: usize) -> (Option<Vec<bool>>, Option<Vec<b
     (Some(verts), Some(tets))
 }
 
-/// Phase 1: 1-4 split of every selected tet at its barycentre.
+/// Phase 1: 1-4 split of every selected tet at its barycentre, in bulk
+/// ([`split14_bulk`]).
 fn split_phase(mesh: &mut TetMesh, opts: &RefineOptions, report: &mut StepReport) {
-    let ids: Vec<u32> = mesh
-        .tet_ids()
-        .filter(|&t| match &opts.selection {
-            Some(sel) => sel.get(t as usize).copied().unwrap_or(false),
-            None => true,
-        })
-        .collect();
-    mesh.reserve(3 * ids.len(), ids.len());
-    for t in ids {
-        let p = mesh.tet_points(t);
-        let c = (p[0] + p[1] + p[2] + p[3]) * 0.25;
-        let level = mesh.level(t);
-        // The barycentre of a positive tet is strictly inside it, so the split
-        // cannot be refused; should rounding ever say otherwise, the tet stays.
-        if let Ok(children) = split14(mesh, t, c) {
-            for ch in children {
-                mesh.set_level(ch, level.saturating_add(1));
-            }
-            report.split += 1;
-        }
-    }
+    report.split += split14_bulk(mesh, opts.selection.as_deref());
 }
 
 /// Phase 2: 2-3 flip of each old interior face whose two tets were both split:
-/// the children holding it have the two barycentres as apexes.
+/// the children holding it have the two barycentres as apexes. Validity is
+/// decided in parallel, the rare invalid flips are repaired one by one
+/// ([`make_flips_valid`]), then all valid flips are done in bulk
+/// ([`flip23_bulk`]).
 fn flip_phase(mesh: &mut TetMesh, st: &StepState, report: &mut StepReport) {
     let first = st.first_barycentre;
-    let mut faces = Vec::new();
-    for t in mesh.tet_ids() {
-        let v = mesh.tet(t);
-        // A child of this step's split has exactly one barycentre, opposite
-        // the old face it holds.
-        let Some(i) = (0..4).find(|&i| v[i] >= first) else {
-            continue;
-        };
-        if (0..4).filter(|&j| v[j] >= first).count() != 1 {
-            continue;
-        }
-        let h = mesh.adj(t)[i];
-        if h == NO_ADJ {
-            continue;
-        }
-        let (u, g) = TetMesh::half_face(h);
-        if u > t && mesh.tet(u)[g] >= first && !is_constrained(mesh, t, i) {
-            faces.push((t, i));
-        }
+    let mut batch = FlipBatch::barycentre_faces(mesh, first);
+    let invalid = batch.invalid_faces();
+    if !invalid.is_empty() && make_flips_valid(mesh, first, &batch.faces(), &invalid, report) {
+        batch.revalidate(mesh);
     }
-    make_flips_valid(mesh, first, &faces, report);
-    for (t, f) in faces {
-        match flip23(mesh, t, f) {
-            Ok(_) => report.flipped += 1,
-            Err(_) => report.refused_flips += 1,
-        }
-    }
+    let n = batch.len();
+    let flipped = flip23_bulk(mesh, batch);
+    report.flipped += flipped;
+    report.refused_flips += n - flipped;
 }
 
 /// Where the segment between two barycentres misses their shared face (the
@@ -215,20 +181,15 @@ fn flip_phase(mesh: &mut TetMesh, st: &StepState, report: &mut StepReport) {
 /// inside their parents, so the children stay valid — as long as no other
 /// flip of theirs that was valid becomes invalid. The optimize phase moves
 /// these points again later. Counted in `StepReport::moved_barycentres`.
+/// Returns whether any point moved.
 fn make_flips_valid(
     mesh: &mut TetMesh,
     first: u32,
     faces: &[(u32, usize)],
+    invalid: &[(u32, usize)],
     report: &mut StepReport,
-) {
-    let invalid: Vec<(u32, usize)> = faces
-        .iter()
-        .copied()
-        .filter(|&(t, f)| !flip23_valid(mesh, t, f))
-        .collect();
-    if invalid.is_empty() {
-        return;
-    }
+) -> bool {
+    let mut moved = false;
     // The flip faces around each barycentre, to re-check its other flips.
     let mut around: HashMap<u32, Vec<(u32, usize)>> = HashMap::new();
     for &(t, f) in faces {
@@ -240,7 +201,7 @@ fn make_flips_valid(
         around.entry(q).or_default().push((t, f));
     }
     let mut ball = Vec::new();
-    for (t, f) in invalid {
+    for &(t, f) in invalid {
         let h = mesh.adj(t)[f];
         let (u, g) = TetMesh::half_face(h);
         let (p, q) = (mesh.tet(t)[f], mesh.tet(u)[g]);
@@ -287,18 +248,10 @@ fn make_flips_valid(
         }
         if fixed {
             report.moved_barycentres += 2;
+            moved = true;
         }
     }
-}
-
-/// Whether interior face `f` of `t` must survive like the boundary: it
-/// separates two regions or carries a marker.
-fn is_constrained(mesh: &TetMesh, t: u32, f: usize) -> bool {
-    let h = mesh.adj(t)[f];
-    h != NO_ADJ
-        && (mesh.region(h >> 2) != mesh.region(t)
-            || (!mesh.face_markers().is_empty()
-                && mesh.face_marker(mesh.face_vertices(t, f)).is_some()))
+    moved
 }
 
 /// Phase 3: 1-3 split of every boundary face of a split tet at its
@@ -317,7 +270,7 @@ fn boundary_split_phase(mesh: &mut TetMesh, st: &mut StepState, report: &mut Ste
             }
             if mesh.is_boundary_face(t, f) {
                 faces.push((t, f));
-            } else if is_constrained(mesh, t, f) {
+            } else if is_constrained_face(mesh, t, f) {
                 let (u, g) = TetMesh::half_face(mesh.adj(t)[f]);
                 let w = mesh.tet(u);
                 if u > t && w[g] >= first && (0..4).all(|j| j == g || w[j] < first) {
