@@ -9,12 +9,19 @@
 //! (closed rings inside one region) are removed, so the domain, its regions
 //! and its tags are untouched.
 
-use super::laplacian::laplacian_smooth;
-use super::optimize::{optimize_vertex, OptimizeParams};
+use super::colour::{colour_balls, Balls};
+use super::laplacian::laplacian_position;
+use super::optimize::{optimize_position, OptimizeParams};
+use super::ring::{canonicalize_ring, improving_ring_triangulation, RingScratch};
+use super::tet_points_with;
 use crate::geom::{tet_min_sine, TET_EDGES};
-use crate::mesh::fasthash::FastHashSet;
-use crate::mesh::{edge_key, TetMarks, TetMesh, NO_ADJ};
-use crate::ops::{remove_edge, EdgeRing};
+use crate::mesh::{TetMesh, NO_ADJ};
+use crate::ops::edge_removal::{apply_ring_triangulation, RingTriangulation};
+use crate::ops::EdgeRing;
+use glam::DVec3;
+use rayon::prelude::*;
+use std::sync::atomic::{AtomicU8, Ordering};
+use std::time::Instant;
 
 /// Options of [`improve`].
 #[derive(Clone, Debug)]
@@ -109,6 +116,8 @@ struct Tracker {
 impl Tracker {
     fn new(mesh: &TetMesh, allowed: Option<Vec<bool>>) -> Tracker {
         let tq = (0..mesh.n_tet_slots() as u32)
+            .into_par_iter()
+            .with_min_len(4096)
             .map(|t| {
                 if mesh.is_alive(t) {
                     tet_min_sine(&mesh.tet_points(t))
@@ -135,10 +144,9 @@ impl Tracker {
         }
     }
 
-    /// Refreshes the quality of `t` and flags it and its vertices.
-    fn touch(&mut self, mesh: &TetMesh, t: u32) {
-        self.grow(mesh.n_tet_slots());
-        self.tq[t as usize] = tet_min_sine(&mesh.tet_points(t));
+    /// Records quality `q` for `t` and flags it and its vertices.
+    fn set(&mut self, mesh: &TetMesh, t: u32, q: f64) {
+        self.tq[t as usize] = q;
         self.tet_dirty[t as usize] = true;
         for v in mesh.tet(t) {
             self.vert_dirty[v as usize] = true;
@@ -152,123 +160,395 @@ impl Tracker {
     }
 }
 
+/// Local edge index (into [`TET_EDGES`]) of local vertices `i != j`.
+const EDGE_OF: [[u8; 4]; 4] = [[6, 0, 1, 2], [0, 6, 3, 4], [1, 3, 6, 5], [2, 4, 5, 6]];
+
+static PROF_GATHERS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+static PROF_DPS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+static PROF_RING: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+/// Temporary profiling (removed before merge).
+struct Prof {
+    on: bool,
+    t: Instant,
+    cpu: f64,
+}
+
+fn cpu_seconds() -> f64 {
+    let s = std::fs::read_to_string("/proc/self/stat").unwrap_or_default();
+    let f: Vec<&str> = s.rsplit(')').next().unwrap_or("").split_whitespace().collect();
+    let tick = |i: usize| f.get(i).and_then(|x| x.parse::<f64>().ok()).unwrap_or(0.0);
+    (tick(11) + tick(12)) / 100.0
+}
+
+impl Prof {
+    fn lap(&mut self, what: &str) {
+        if self.on {
+            let c = cpu_seconds();
+            eprintln!(
+                "  improve {what}: {:.3}s wall {:.2}s cpu",
+                self.t.elapsed().as_secs_f64(),
+                c - self.cpu
+            );
+            self.cpu = c;
+        }
+        self.t = Instant::now();
+    }
+}
+
 /// Runs the optimisation passes on `mesh`.
+///
+/// Edge removal runs tet by tet; vertex smoothing runs by colour classes
+/// (see [`super::colour`]), each class in parallel. The result does not
+/// depend on the number of threads.
 pub fn improve(mesh: &mut TetMesh, opts: &ImproveOptions) -> ImproveReport {
-    let fixed = fixed_vertices(mesh);
-    let mut report = ImproveReport::default();
-    let mut ring = EdgeRing::default();
-    let mut ball = Vec::new();
-    let mut scratch = Vec::new();
-    let mut marks = TetMarks::default();
-    let params = OptimizeParams::default();
-    let mut tr = Tracker::new(mesh, opts.tet_allowed.clone());
-    let movable = |v: u32| {
-        !fixed[v as usize]
-            && opts
-                .movable
-                .as_ref()
-                .is_none_or(|m| m.get(v as usize).copied().unwrap_or(false))
+    let mut prof = Prof {
+        on: std::env::var_os("TETREFINE_IMPROVE_PROF").is_some(),
+        t: Instant::now(),
+        cpu: cpu_seconds(),
     };
+    let fixed = fixed_vertices(mesh);
+    let movable: Vec<bool> = (0..mesh.n_points())
+        .map(|v| {
+            !fixed[v]
+                && opts
+                    .movable
+                    .as_ref()
+                    .is_none_or(|m| m.get(v).copied().unwrap_or(false))
+        })
+        .collect();
+    drop(fixed);
+    let mut report = ImproveReport::default();
+    let mut tr = Tracker::new(mesh, opts.tet_allowed.clone());
+    let mut edges = EdgeRemoval::default();
+    let mut masks = Vec::new();
+    prof.lap("init");
     for _ in 0..opts.passes {
         report.passes += 1;
-        let mut changed = 0;
+        let mut changed = edges.pass(mesh, &mut tr, opts, &mut report);
+        prof.lap("edge removal");
+        changed += smooth_pass(mesh, &mut tr, &movable, opts, &mut masks, &mut report, &mut prof);
+        if changed == 0 {
+            break;
+        }
+    }
+    report
+}
 
-        // Interior edge removal, on the edges of dirty low-quality tets, each
-        // edge tried once per pass.
+/// A removable edge found by the search half of an edge removal pass.
+struct Removable {
+    ring: EdgeRing,
+    tri: RingTriangulation,
+}
+
+/// Buffers of the edge removal passes.
+#[derive(Default)]
+struct EdgeRemoval {
+    /// Per tet slot, bit `e`: local edge `e` was tried in this pass.
+    tried: Vec<AtomicU8>,
+    /// Per tet slot: replaced or created in this pass.
+    modified: Vec<bool>,
+}
+
+/// Per-thread buffers of the edge search.
+#[derive(Default)]
+struct EdgeScratch {
+    ring: EdgeRing,
+    dp: RingScratch,
+}
+
+impl EdgeRemoval {
+    /// Interior edge removal on the edges of dirty low-quality tets, each edge
+    /// tried once per pass. Returns the number of edges removed.
+    ///
+    /// The search runs in parallel on the mesh as it stands: every edge of a
+    /// candidate tet whose closed ring can be re-triangulated with a better
+    /// worst tet (see [`improving_ring_triangulation`]) is recorded with its
+    /// triangulation. Whichever thread finds an edge, its ring is put in
+    /// canonical form first ([`canonicalize_ring`]), so the records do not
+    /// depend on the threads. They are then applied one by one in the order
+    /// of their rings' lowest tet slot, skipping any whose ring an earlier
+    /// removal of this pass changed (its new tets are dirty, so the next pass
+    /// looks there again).
+    fn pass(
+        &mut self,
+        mesh: &mut TetMesh,
+        tr: &mut Tracker,
+        opts: &ImproveOptions,
+        report: &mut ImproveReport,
+    ) -> usize {
         let candidates: Vec<u32> = (0..mesh.n_tet_slots() as u32)
+            .into_par_iter()
+            .with_min_len(4096)
             .filter(|&t| {
                 let i = t as usize;
-                mesh.is_alive(t)
-                    && tr.tet_dirty[i]
+                tr.tet_dirty[i]
                     && tr.tq[i] < opts.edge_threshold
+                    && mesh.is_alive(t)
                     && tr.is_allowed(t)
             })
             .collect();
         for &t in &candidates {
             tr.tet_dirty[t as usize] = false;
         }
-        let mut tried: FastHashSet<[u32; 2]> =
-            FastHashSet::with_capacity_and_hasher(4 * candidates.len(), Default::default());
-        for t in candidates {
-            if !mesh.is_alive(t) || tr.tq[t as usize] >= opts.edge_threshold {
+        self.tried.clear();
+        self.tried
+            .resize_with(mesh.n_tet_slots(), || AtomicU8::new(0));
+        let mut found: Vec<Removable> = {
+            let mesh = &*mesh;
+            let tr = &*tr;
+            let tried = &self.tried;
+            candidates
+                .par_chunks(256)
+                .map_init(EdgeScratch::default, |s, chunk| {
+                    let mut found = Vec::new();
+                    for &t in chunk {
+                        search_tet(mesh, tr, tried, opts, t, s, &mut found);
+                    }
+                    found
+                })
+                .flatten_iter()
+                .collect()
+        };
+        if std::env::var_os("TETREFINE_IMPROVE_PROF").is_some() {
+            eprintln!("  edges: {} candidates, {} gathers, {} dps (ring sum {}), {} found", candidates.len(), PROF_GATHERS.swap(0, Ordering::Relaxed), PROF_DPS.swap(0, Ordering::Relaxed), PROF_RING.swap(0, Ordering::Relaxed), found.len());
+        }
+        // Two threads may have found the same edge at once: same record.
+        found.sort_unstable_by_key(|f| (f.ring.tets[0], f.ring.a, f.ring.b));
+        found.dedup_by_key(|f| (f.ring.tets[0], f.ring.a, f.ring.b));
+        self.modified.clear();
+        self.modified.resize(mesh.n_tet_slots(), false);
+        let mut removed = 0;
+        for f in found {
+            if f.ring.tets.iter().any(|&u| self.modified[u as usize]) {
                 continue;
             }
-            let v = mesh.tet(t);
-            for (e, [i, j]) in TET_EDGES.iter().enumerate() {
-                if !tried.insert(edge_key(v[*i], v[*j])) || mesh.is_feature_edge(v[*i], v[*j]) {
-                    continue;
-                }
-                ring.gather_into(mesh, t, e);
-                if !ring.closed
-                    || ring.tets.len() > opts.max_ring
-                    || !ring.tets.iter().all(|&u| tr.is_allowed(u))
-                {
-                    continue;
-                }
-                let worst = ring
-                    .tets
-                    .iter()
-                    .map(|&u| tr.tq[u as usize])
-                    .fold(f64::INFINITY, f64::min);
-                if let Ok(new) = remove_edge(mesh, &ring, worst + 1e-12) {
-                    changed += 1;
-                    report.edges_removed += 1;
-                    for n in new {
-                        tr.touch(mesh, n);
-                        if let Some(a) = &mut tr.allowed {
-                            a[n as usize] = true;
-                        }
-                    }
-                    break; // t is gone
+            let Ok(new) = apply_ring_triangulation(mesh, &f.ring, &f.tri) else {
+                continue;
+            };
+            removed += 1;
+            let slots = mesh.n_tet_slots();
+            tr.grow(slots);
+            self.modified.resize(slots.max(self.modified.len()), false);
+            for &u in &f.ring.tets {
+                self.modified[u as usize] = true;
+            }
+            for n in new {
+                self.modified[n as usize] = true;
+                let q = tet_min_sine(&mesh.tet_points(n));
+                tr.set(mesh, n, q);
+                if let Some(a) = &mut tr.allowed {
+                    a[n as usize] = true;
                 }
             }
         }
+        report.edges_removed += removed;
+        removed
+    }
+}
 
-        // Vertex smoothing of dirty vertices whose worst tet is poor.
-        let mut vq = vec![f64::INFINITY; mesh.n_points()];
-        for t in mesh.tet_ids() {
-            let q = tr.tq[t as usize];
-            for x in mesh.tet(t) {
+/// The search half of [`EdgeRemoval::pass`] for the edges of candidate tet
+/// `t` not tried yet: appends the removable ones to `found`.
+fn search_tet(
+    mesh: &TetMesh,
+    tr: &Tracker,
+    tried: &[AtomicU8],
+    opts: &ImproveOptions,
+    t: u32,
+    s: &mut EdgeScratch,
+    found: &mut Vec<Removable>,
+) {
+    let v = mesh.tet(t);
+    for (e, &[i, j]) in TET_EDGES.iter().enumerate() {
+        if tried[t as usize].fetch_or(1 << e, Ordering::Relaxed) & (1 << e) != 0
+            || mesh.is_feature_edge(v[i], v[j])
+        {
+            continue;
+        }
+        let ring = &mut s.ring;
+        PROF_GATHERS.fetch_add(1, Ordering::Relaxed);
+        ring.gather_into(mesh, t, e);
+        // Every tet of the ring holds the edge: it is tried now.
+        for &u in &ring.tets {
+            let uv = mesh.tet(u);
+            let ia = uv.iter().position(|&x| x == ring.a).unwrap_or(0);
+            let ib = uv.iter().position(|&x| x == ring.b).unwrap_or(1);
+            let k = EDGE_OF[ia][ib];
+            if k < 6 {
+                tried[u as usize].fetch_or(1 << k, Ordering::Relaxed);
+            }
+        }
+        if !ring.closed
+            || ring.tets.len() > opts.max_ring
+            || !ring.tets.iter().all(|&u| tr.is_allowed(u))
+        {
+            continue;
+        }
+        canonicalize_ring(ring);
+        PROF_DPS.fetch_add(1, Ordering::Relaxed);
+        PROF_RING.fetch_add(ring.tets.len(), Ordering::Relaxed);
+        let worst = ring
+            .tets
+            .iter()
+            .map(|&u| tr.tq[u as usize])
+            .fold(f64::INFINITY, f64::min);
+        if let Some(tri) = improving_ring_triangulation(mesh, ring, worst + 1e-12, &mut s.dp) {
+            found.push(Removable {
+                ring: ring.clone(),
+                tri,
+            });
+        }
+    }
+}
+
+/// Per-thread buffers of vertex smoothing.
+#[derive(Default)]
+struct SmoothScratch {
+    neighbours: Vec<u32>,
+    qualities: Vec<f64>,
+}
+
+/// A vertex move decided by [`smooth_vertex`].
+struct VertexMove {
+    /// New position.
+    x: DVec3,
+    /// Moved by Laplacian smoothing.
+    laplacian: bool,
+    /// Moved by optimization-based smoothing.
+    optimized: bool,
+    /// Qualities of the ball's tets at `x`, in ball order.
+    qualities: Vec<f64>,
+}
+
+/// The move of `v` (ball `ball`, per-slot qualities `tq`): a Laplacian try
+/// kept only if it raises the worst tet and keeps the mean, then
+/// optimization-based smoothing if the worst tet is still below the
+/// threshold. Reads only the ball's points and qualities.
+fn smooth_vertex(
+    mesh: &TetMesh,
+    tq: &[f64],
+    v: u32,
+    ball: &[u32],
+    opts: &ImproveOptions,
+    s: &mut SmoothScratch,
+) -> Option<VertexMove> {
+    let mut q = f64::INFINITY;
+    let mut sum = 0.0;
+    for &t in ball {
+        let qt = tq[t as usize];
+        q = q.min(qt);
+        sum += qt;
+    }
+    let mean = sum / ball.len().max(1) as f64;
+    let mut x = mesh.point(v);
+    let mut laplacian = false;
+    if let Some((x2, q2)) =
+        laplacian_position(mesh, v, ball, q, mean, &mut s.neighbours, &mut s.qualities)
+    {
+        x = x2;
+        q = q2;
+        laplacian = true;
+    }
+    let mut optimized = false;
+    if q < opts.threshold {
+        if let Some((x3, _)) = optimize_position(mesh, v, x, ball, &OptimizeParams::default()) {
+            x = x3;
+            optimized = true;
+        }
+    }
+    if !(laplacian || optimized) {
+        return None;
+    }
+    let qualities = if optimized {
+        ball.iter()
+            .map(|&t| tet_min_sine(&tet_points_with(mesh, t, v, x)))
+            .collect()
+    } else {
+        s.qualities.clone()
+    };
+    Some(VertexMove {
+        x,
+        laplacian,
+        optimized,
+        qualities,
+    })
+}
+
+/// Vertex smoothing of dirty movable vertices whose worst tet is poor, colour
+/// class by colour class. Returns the number of vertices moved.
+#[allow(clippy::too_many_arguments)]
+fn smooth_pass(
+    mesh: &mut TetMesh,
+    tr: &mut Tracker,
+    movable: &[bool],
+    opts: &ImproveOptions,
+    masks: &mut Vec<u64>,
+    report: &mut ImproveReport,
+    prof: &mut Prof,
+) -> usize {
+    let mut vq = vec![f64::INFINITY; mesh.n_points()];
+    for (t, tv) in mesh.tet_slots().iter().enumerate() {
+        let q = tr.tq[t];
+        if q.is_finite() && mesh.is_alive(t as u32) {
+            for &x in tv {
                 let s = &mut vq[x as usize];
                 *s = s.min(q);
             }
         }
-        for v in 0..mesh.n_points() as u32 {
-            if !tr.vert_dirty[v as usize] || !movable(v) {
-                continue;
-            }
-            tr.vert_dirty[v as usize] = false;
-            if vq[v as usize] >= opts.threshold.max(opts.laplacian_threshold) {
-                continue;
-            }
-            mesh.ball_marked(v, &mut ball, &mut marks);
-            if ball.is_empty() {
-                continue;
-            }
-            let mut q = ball
-                .iter()
-                .map(|&t| tr.tq[t as usize])
-                .fold(f64::INFINITY, f64::min);
-            let mut moved = false;
-            if let Some(q2) = laplacian_smooth(mesh, v, &ball, q, &mut scratch) {
-                q = q2;
-                moved = true;
-                report.laplacian_moves += 1;
-            }
-            if q < opts.threshold && optimize_vertex(mesh, v, &ball, &params).is_some() {
-                moved = true;
-                report.optimized_moves += 1;
-            }
-            if moved {
-                changed += 1;
-                for &t in &ball {
-                    tr.touch(mesh, t);
-                }
-            }
+    }
+    let bar = opts.threshold.max(opts.laplacian_threshold);
+    let mut verts = Vec::new();
+    for v in 0..mesh.n_points() {
+        if !tr.vert_dirty[v] || !movable[v] {
+            continue;
         }
-        if changed == 0 {
-            break;
+        tr.vert_dirty[v] = false;
+        if vq[v] < bar {
+            verts.push(v as u32);
         }
     }
-    report
+    drop(vq);
+    prof.lap("vq + candidates");
+    let balls = Balls::gather(mesh, &verts);
+    prof.lap("balls");
+    let classes = colour_balls(&balls, masks);
+    prof.lap("colouring");
+    let mut moved = 0;
+    for class in &classes {
+        let moves: Vec<Option<VertexMove>> = {
+            let mesh = &*mesh;
+            let tq = &tr.tq;
+            class
+                .par_iter()
+                .with_min_len(64)
+                .map_init(SmoothScratch::default, |s, &i| {
+                    let ball = balls.ball(i as usize);
+                    if ball.is_empty() {
+                        return None;
+                    }
+                    smooth_vertex(mesh, tq, verts[i as usize], ball, opts, s)
+                })
+                .collect()
+        };
+        for (&i, m) in class.iter().zip(moves) {
+            let Some(m) = m else { continue };
+            let v = verts[i as usize];
+            mesh.set_point(v, m.x);
+            for (&t, &q) in balls.ball(i as usize).iter().zip(&m.qualities) {
+                tr.set(mesh, t, q);
+            }
+            moved += 1;
+            report.laplacian_moves += m.laplacian as usize;
+            report.optimized_moves += m.optimized as usize;
+        }
+    }
+    if prof.on {
+        eprintln!(
+            "  improve: {} candidates, {} classes, {} moved",
+            verts.len(),
+            classes.len(),
+            moved
+        );
+    }
+    prof.lap("smoothing");
+    moved
 }

@@ -1,7 +1,8 @@
 //! Laplacian smoothing: the vertex goes to the centroid of its neighbours
 //! (Field 1988), kept only if the worst tet of its ball improves.
 
-use super::{ball_min_mean_at, ball_stays_positive, vertex_neighbours};
+use super::{ball_min_mean_at, ball_stays_positive, tet_points_with, vertex_neighbours};
+use crate::geom::tet_min_sine;
 use crate::mesh::TetMesh;
 use glam::DVec3;
 
@@ -14,6 +15,40 @@ pub fn laplacian_target(mesh: &TetMesh, v: u32, ball: &[u32], scratch: &mut Vec<
     scratch.iter().map(|&u| mesh.point(u)).sum::<DVec3>() / scratch.len() as f64
 }
 
+/// Where [`laplacian_smooth`] would move `v`, without moving it: the
+/// Laplacian target and the ball's new worst quality, if the target raises the
+/// worst quality above `current` without lowering the mean below
+/// `current_mean` (the ball's mean quality as it stands) or inverting anything.
+/// On success `qualities` holds the ball's tet qualities at the target, in
+/// `ball` order.
+pub fn laplacian_position(
+    mesh: &TetMesh,
+    v: u32,
+    ball: &[u32],
+    current: f64,
+    current_mean: f64,
+    scratch: &mut Vec<u32>,
+    qualities: &mut Vec<f64>,
+) -> Option<(DVec3, f64)> {
+    let x = laplacian_target(mesh, v, ball, scratch);
+    qualities.clear();
+    let mut q = f64::INFINITY;
+    let mut sum = 0.0;
+    for &t in ball {
+        let s = tet_min_sine(&tet_points_with(mesh, t, v, x));
+        // The worst tet must rise above `current`: any tet at or below it
+        // settles the answer.
+        if !(s > current) {
+            return None;
+        }
+        q = q.min(s);
+        sum += s;
+        qualities.push(s);
+    }
+    let mean = sum / ball.len().max(1) as f64;
+    (mean >= current_mean && ball_stays_positive(mesh, v, ball, x)).then_some((x, q))
+}
+
 /// Moves `v` to its Laplacian target if that raises the ball's worst quality
 /// above `current` without lowering the ball's mean quality or inverting
 /// anything. Returns the new worst quality if it moved.
@@ -24,15 +59,8 @@ pub fn laplacian_smooth(
     current: f64,
     scratch: &mut Vec<u32>,
 ) -> Option<f64> {
-    let x = laplacian_target(mesh, v, ball, scratch);
-    let (q, mean) = ball_min_mean_at(mesh, v, ball, x);
-    if q > current
-        && mean >= ball_min_mean_at(mesh, v, ball, mesh.point(v)).1
-        && ball_stays_positive(mesh, v, ball, x)
-    {
-        mesh.set_point(v, x);
-        Some(q)
-    } else {
-        None
-    }
+    let mean = ball_min_mean_at(mesh, v, ball, mesh.point(v)).1;
+    let (x, q) = laplacian_position(mesh, v, ball, current, mean, scratch, &mut Vec::new())?;
+    mesh.set_point(v, x);
+    Some(q)
 }
