@@ -97,7 +97,7 @@ pub fn colour_balls(balls: &Balls, masks: &mut Vec<u64>) -> Vec<Vec<u32>> {
             used |= masks[t];
         }
         let c = (!used).trailing_zeros() as usize;
-        if c == 64 {
+        if c == 64 || std::env::var_os("TETREFINE_SEQ").is_some() {
             alone.push(i as u32);
             continue;
         }

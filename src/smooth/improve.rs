@@ -15,7 +15,8 @@ use super::optimize::{optimize_position, OptimizeParams};
 use super::ring::{canonicalize_ring, improving_ring_triangulation, RingScratch};
 use super::tet_points_with;
 use crate::geom::{tet_min_sine, TET_EDGES};
-use crate::mesh::{TetMesh, NO_ADJ};
+use crate::mesh::fasthash::{FastHashMap, FastHashSet};
+use crate::mesh::{edge_key, EdgeKey, TetMesh, NO_ADJ};
 use crate::ops::edge_removal::{apply_ring_triangulation, RingTriangulation};
 use crate::ops::EdgeRing;
 use glam::DVec3;
@@ -245,8 +246,10 @@ struct Removable {
 struct EdgeRemoval {
     /// Per tet slot, bit `e`: local edge `e` was tried in this pass.
     tried: Vec<AtomicU8>,
-    /// Per tet slot: replaced or created in this pass.
-    modified: Vec<bool>,
+    /// Per tet slot: in the ring of a recorded removable edge.
+    has_found: Vec<bool>,
+    /// Per point: a vertex of a cavity re-triangulated in this pass.
+    touched: Vec<bool>,
 }
 
 /// Per-thread buffers of the edge search.
@@ -312,38 +315,103 @@ impl EdgeRemoval {
         if std::env::var_os("TETREFINE_IMPROVE_PROF").is_some() {
             eprintln!("  edges: {} candidates, {} gathers, {} dps (ring sum {}), {} found", candidates.len(), PROF_GATHERS.swap(0, Ordering::Relaxed), PROF_DPS.swap(0, Ordering::Relaxed), PROF_RING.swap(0, Ordering::Relaxed), found.len());
         }
-        // Two threads may have found the same edge at once: same record.
-        found.sort_unstable_by_key(|f| (f.ring.tets[0], f.ring.a, f.ring.b));
-        found.dedup_by_key(|f| (f.ring.tets[0], f.ring.a, f.ring.b));
-        self.modified.clear();
-        self.modified.resize(mesh.n_tet_slots(), false);
-        let mut removed = 0;
+        // The records by edge; two threads may have found the same edge at
+        // once (same record). `has_found` flags the tets of their rings.
+        self.has_found.clear();
+        self.has_found.resize(mesh.n_tet_slots(), false);
+        let mut by_edge: FastHashMap<EdgeKey, Removable> =
+            FastHashMap::with_capacity_and_hasher(found.len(), Default::default());
         for f in found {
-            if f.ring.tets.iter().any(|&u| self.modified[u as usize]) {
-                continue;
-            }
-            let Ok(new) = apply_ring_triangulation(mesh, &f.ring, &f.tri) else {
-                continue;
-            };
-            removed += 1;
-            let slots = mesh.n_tet_slots();
-            tr.grow(slots);
-            self.modified.resize(slots.max(self.modified.len()), false);
             for &u in &f.ring.tets {
-                self.modified[u as usize] = true;
+                self.has_found[u as usize] = true;
             }
-            for n in new {
-                self.modified[n as usize] = true;
-                let q = tet_min_sine(&mesh.tet_points(n));
-                tr.set(mesh, n, q);
-                if let Some(a) = &mut tr.allowed {
-                    a[n as usize] = true;
+            by_edge.insert(edge_key(f.ring.a, f.ring.b), f);
+        }
+        // Apply, visiting the candidates' edges in order as a sequential pass
+        // would. Removing an edge changes only tets whose vertices are all in
+        // its cavity, so the ring of an edge with an end outside every cavity
+        // so far is still the one the search saw: its record (or the lack of
+        // one) stands. Edges with both ends touched are searched again.
+        self.touched.clear();
+        self.touched.resize(mesh.n_points(), false);
+        let mut retried: FastHashSet<EdgeKey> = FastHashSet::default();
+        let mut removed = 0;
+        let mut scratch = EdgeScratch::default();
+        for t in candidates {
+            if !mesh.is_alive(t) || tr.tq[t as usize] >= opts.edge_threshold {
+                continue;
+            }
+            let v = mesh.tet(t);
+            for (e, &[i, j]) in TET_EDGES.iter().enumerate() {
+                let key = edge_key(v[i], v[j]);
+                let rec = if self.touched[v[i] as usize] && self.touched[v[j] as usize] {
+                    if !retried.insert(key) || mesh.is_feature_edge(v[i], v[j]) {
+                        continue;
+                    }
+                    search_edge(mesh, tr, opts, t, e, &mut scratch)
+                } else if (t as usize) < self.has_found.len() && self.has_found[t as usize] {
+                    by_edge.remove(&key)
+                } else {
+                    None
+                };
+                let Some(f) = rec else { continue };
+                let Ok(new) = apply_ring_triangulation(mesh, &f.ring, &f.tri) else {
+                    continue;
+                };
+                removed += 1;
+                let slots = mesh.n_tet_slots();
+                tr.grow(slots);
+                for &x in f.ring.verts.iter().chain([&f.ring.a, &f.ring.b]) {
+                    self.touched[x as usize] = true;
                 }
+                for n in new {
+                    let q = tet_min_sine(&mesh.tet_points(n));
+                    tr.set(mesh, n, q);
+                    if let Some(a) = &mut tr.allowed {
+                        a[n as usize] = true;
+                    }
+                }
+                break; // t is gone
             }
+        }
+        if std::env::var_os("TETREFINE_IMPROVE_PROF").is_some() {
+            eprintln!("  edges: {removed} removed, {} retried", retried.len());
         }
         report.edges_removed += removed;
         removed
     }
+}
+
+/// Gathers the ring of local edge `e` of `t` into `s.ring` and, if it is a
+/// closed ring of allowed tets that can be re-triangulated with a better worst
+/// tet, returns it in canonical form with its triangulation.
+fn search_edge(
+    mesh: &TetMesh,
+    tr: &Tracker,
+    opts: &ImproveOptions,
+    t: u32,
+    e: usize,
+    s: &mut EdgeScratch,
+) -> Option<Removable> {
+    let ring = &mut s.ring;
+    ring.gather_into(mesh, t, e);
+    if !ring.closed
+        || ring.tets.len() > opts.max_ring
+        || !ring.tets.iter().all(|&u| tr.is_allowed(u))
+    {
+        return None;
+    }
+    let worst = ring
+        .tets
+        .iter()
+        .map(|&u| tr.tq[u as usize])
+        .fold(f64::INFINITY, f64::min);
+    canonicalize_ring(ring);
+    let tri = improving_ring_triangulation(mesh, ring, worst + 1e-12, &mut s.dp)?;
+    Some(Removable {
+        ring: ring.clone(),
+        tri,
+    })
 }
 
 /// The search half of [`EdgeRemoval::pass`] for the edges of candidate tet
@@ -364,39 +432,19 @@ fn search_tet(
         {
             continue;
         }
-        let ring = &mut s.ring;
         PROF_GATHERS.fetch_add(1, Ordering::Relaxed);
-        ring.gather_into(mesh, t, e);
+        let rec = search_edge(mesh, tr, opts, t, e, s);
         // Every tet of the ring holds the edge: it is tried now.
-        for &u in &ring.tets {
+        for &u in &s.ring.tets {
             let uv = mesh.tet(u);
-            let ia = uv.iter().position(|&x| x == ring.a).unwrap_or(0);
-            let ib = uv.iter().position(|&x| x == ring.b).unwrap_or(1);
+            let ia = uv.iter().position(|&x| x == s.ring.a).unwrap_or(0);
+            let ib = uv.iter().position(|&x| x == s.ring.b).unwrap_or(1);
             let k = EDGE_OF[ia][ib];
             if k < 6 {
                 tried[u as usize].fetch_or(1 << k, Ordering::Relaxed);
             }
         }
-        if !ring.closed
-            || ring.tets.len() > opts.max_ring
-            || !ring.tets.iter().all(|&u| tr.is_allowed(u))
-        {
-            continue;
-        }
-        canonicalize_ring(ring);
-        PROF_DPS.fetch_add(1, Ordering::Relaxed);
-        PROF_RING.fetch_add(ring.tets.len(), Ordering::Relaxed);
-        let worst = ring
-            .tets
-            .iter()
-            .map(|&u| tr.tq[u as usize])
-            .fold(f64::INFINITY, f64::min);
-        if let Some(tri) = improving_ring_triangulation(mesh, ring, worst + 1e-12, &mut s.dp) {
-            found.push(Removable {
-                ring: ring.clone(),
-                tri,
-            });
-        }
+        found.extend(rec);
     }
 }
 
@@ -432,18 +480,29 @@ fn smooth_vertex(
     s: &mut SmoothScratch,
 ) -> Option<VertexMove> {
     let mut q = f64::INFINITY;
+    let mut worst = 0;
     let mut sum = 0.0;
-    for &t in ball {
+    for (i, &t) in ball.iter().enumerate() {
         let qt = tq[t as usize];
-        q = q.min(qt);
+        if qt < q {
+            q = qt;
+            worst = i;
+        }
         sum += qt;
     }
     let mean = sum / ball.len().max(1) as f64;
     let mut x = mesh.point(v);
     let mut laplacian = false;
-    if let Some((x2, q2)) =
-        laplacian_position(mesh, v, ball, q, mean, &mut s.neighbours, &mut s.qualities)
-    {
+    if let Some((x2, q2)) = laplacian_position(
+        mesh,
+        v,
+        ball,
+        q,
+        mean,
+        worst,
+        &mut s.neighbours,
+        &mut s.qualities,
+    ) {
         x = x2;
         q = q2;
         laplacian = true;

@@ -19,25 +19,36 @@ pub fn laplacian_target(mesh: &TetMesh, v: u32, ball: &[u32], scratch: &mut Vec<
 /// Laplacian target and the ball's new worst quality, if the target raises the
 /// worst quality above `current` without lowering the mean below
 /// `current_mean` (the ball's mean quality as it stands) or inverting anything.
-/// On success `qualities` holds the ball's tet qualities at the target, in
-/// `ball` order.
+/// `first` is the position in `ball` of a tet to check first (the worst one;
+/// any position works, one past the end for none). On success `qualities`
+/// holds the ball's tet qualities at the target, in `ball` order.
 pub fn laplacian_position(
     mesh: &TetMesh,
     v: u32,
     ball: &[u32],
     current: f64,
     current_mean: f64,
+    first: usize,
     scratch: &mut Vec<u32>,
     qualities: &mut Vec<f64>,
 ) -> Option<(DVec3, f64)> {
     let x = laplacian_target(mesh, v, ball, scratch);
+    // Every tet must end above `current`; any tet at or below it settles the
+    // answer, and the likeliest one to be is the one `first` (the caller's
+    // worst tet), so it is tried before the others.
+    let quality = |t: u32| tet_min_sine(&tet_points_with(mesh, t, v, x));
+    let head = ball.get(first).map(|&t| quality(t));
+    if head.is_some_and(|s| !(s > current)) {
+        return None;
+    }
     qualities.clear();
     let mut q = f64::INFINITY;
     let mut sum = 0.0;
-    for &t in ball {
-        let s = tet_min_sine(&tet_points_with(mesh, t, v, x));
-        // The worst tet must rise above `current`: any tet at or below it
-        // settles the answer.
+    for (i, &t) in ball.iter().enumerate() {
+        let s = match head {
+            Some(h) if i == first => h,
+            _ => quality(t),
+        };
         if !(s > current) {
             return None;
         }
@@ -60,7 +71,16 @@ pub fn laplacian_smooth(
     scratch: &mut Vec<u32>,
 ) -> Option<f64> {
     let mean = ball_min_mean_at(mesh, v, ball, mesh.point(v)).1;
-    let (x, q) = laplacian_position(mesh, v, ball, current, mean, scratch, &mut Vec::new())?;
+    let (x, q) = laplacian_position(
+        mesh,
+        v,
+        ball,
+        current,
+        mean,
+        usize::MAX,
+        scratch,
+        &mut Vec::new(),
+    )?;
     mesh.set_point(v, x);
     Some(q)
 }

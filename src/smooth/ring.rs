@@ -49,6 +49,9 @@ pub fn improving_ring_triangulation(
     s.p.clear();
     s.p.extend(ring.verts.iter().map(|&v| mesh.point(v)));
     let p = &s.p;
+    if ring.closed && ring_bound_fails(pa, pb, p, beat) {
+        return None;
+    }
     // Worst quality of the two tets of triangle (i, k, j) if it beats the
     // bar and both are positive, else −∞.
     let tri_q = |i: usize, k: usize, j: usize| -> f64 {
@@ -110,6 +113,36 @@ pub fn improving_ring_triangulation(
         s.stack.push((k, j));
     }
     Some(RingTriangulation { quality, triangles })
+}
+
+/// Whether a quick upper bound already rules out beating `beat` on a closed
+/// ring with edge ends `pa`, `pb` and ring points `p`.
+///
+/// Each side `(p_i, p_i+1)` of the ring polygon lies in one triangle
+/// `(p_i, p_i+1, p_k)` of any triangulation, and its two new tets (coned to
+/// `a` and to `b`) split the dihedral angle θ of the old tet
+/// `(a, b, p_i, p_i+1)` at that side between them (both positive means the
+/// triangle's half-plane lies inside the old wedge). One of the two has an
+/// angle of at most θ/2 < 90°, so no triangulation beats `sin(θ/2)`. The test
+/// `sin²(θ/2) = (1 − cos θ)/2 ≤ beat²` keeps a margin, so that it only rules
+/// out what the full programme would reject too.
+fn ring_bound_fails(pa: DVec3, pb: DVec3, p: &[DVec3], beat: f64) -> bool {
+    if beat <= 0.0 {
+        return false;
+    }
+    let r = p.len();
+    let limit = 2.0 * beat * beat - 1e-9;
+    for i in 0..r {
+        let (p0, p1) = (p[i], p[(i + 1) % r]);
+        let u = p1 - p0;
+        let na = u.cross(pa - p0);
+        let nb = u.cross(pb - p0);
+        let d = (na.length_squared() * nb.length_squared()).sqrt();
+        if d > 0.0 && 1.0 - na.dot(nb) / d <= limit {
+            return true;
+        }
+    }
+    false
 }
 
 /// Puts a closed ring in a form that does not depend on the tet it was
