@@ -58,7 +58,10 @@ fn perturbed_cube() -> TetMesh {
     mesh
 }
 
-fn improve_with_threads(mesh: &TetMesh, threads: usize) -> (TetMesh, tetrefine::smooth::ImproveReport) {
+fn improve_with_threads(
+    mesh: &TetMesh,
+    threads: usize,
+) -> (TetMesh, tetrefine::smooth::ImproveReport) {
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .build()

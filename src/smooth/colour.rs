@@ -84,9 +84,25 @@ impl Balls {
 /// grown as needed). A vertex that finds all 64 colours taken around it gets a
 /// class of its own, after the others.
 pub fn colour_balls(balls: &Balls, masks: &mut Vec<u64>) -> Vec<Vec<u32>> {
+    colour_balls_except(balls, masks, |_| false)
+}
+
+/// [`colour_balls`], except that each ball for which `alone_if` holds gets a
+/// class of its own, both before and after the coloured classes (in ball
+/// order each time): those vertices are smoothed one at a time, twice.
+pub fn colour_balls_except(
+    balls: &Balls,
+    masks: &mut Vec<u64>,
+    alone_if: impl Fn(usize) -> bool,
+) -> Vec<Vec<u32>> {
     let mut classes: Vec<Vec<u32>> = Vec::new();
     let mut alone = Vec::new();
+    let mut crowded = Vec::new();
     for i in 0..balls.len() {
+        if alone_if(i) {
+            alone.push(i as u32);
+            continue;
+        }
         let ball = balls.ball(i);
         let mut used = 0u64;
         for &t in ball {
@@ -97,8 +113,8 @@ pub fn colour_balls(balls: &Balls, masks: &mut Vec<u64>) -> Vec<Vec<u32>> {
             used |= masks[t];
         }
         let c = (!used).trailing_zeros() as usize;
-        if c == 64 || std::env::var_os("TETREFINE_SEQ").is_some() {
-            alone.push(i as u32);
+        if c == 64 {
+            crowded.push(i as u32);
             continue;
         }
         for &t in ball {
@@ -112,8 +128,11 @@ pub fn colour_balls(balls: &Balls, masks: &mut Vec<u64>) -> Vec<Vec<u32>> {
     for &t in &balls.tets {
         masks[t as usize] = 0;
     }
-    classes.extend(alone.into_iter().map(|i| vec![i]));
-    classes
+    let mut all: Vec<Vec<u32>> = alone.iter().map(|&i| vec![i]).collect();
+    all.extend(classes);
+    all.extend(crowded.into_iter().map(|i| vec![i]));
+    all.extend(alone.iter().map(|&i| vec![i]));
+    all
 }
 
 /// Colour classes of `verts` (see [`colour_balls`]) as lists of vertex ids:
