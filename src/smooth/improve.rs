@@ -165,9 +165,11 @@ const EDGE_OF: [[u8; 4]; 4] = [[6, 0, 1, 2], [0, 6, 3, 4], [1, 3, 6, 5], [2, 4, 
 
 /// Runs the optimisation passes on `mesh`.
 ///
-/// Edge removal runs tet by tet; vertex smoothing runs by colour classes
-/// (see [`super::colour`]), each class in parallel. The result does not
-/// depend on the number of threads.
+/// The edge search and vertex smoothing run in parallel: edges are searched
+/// on the mesh as it stands and removed in order (see `EdgeRemoval::pass`),
+/// vertices are smoothed by colour classes, independent sets smoothed in
+/// parallel (see [`super::colour`]). The result does not depend on the
+/// number of threads.
 pub fn improve(mesh: &mut TetMesh, opts: &ImproveOptions) -> ImproveReport {
     let fixed = fixed_vertices(mesh);
     let movable: Vec<bool> = (0..mesh.n_points())
@@ -228,10 +230,10 @@ impl EdgeRemoval {
     /// worst tet (see [`improving_ring_triangulation`]) is recorded with its
     /// triangulation. Whichever thread finds an edge, its ring is put in
     /// canonical form first ([`canonicalize_ring`]), so the records do not
-    /// depend on the threads. They are then applied one by one in the order
-    /// of their rings' lowest tet slot, skipping any whose ring an earlier
-    /// removal of this pass changed (its new tets are dirty, so the next pass
-    /// looks there again).
+    /// depend on the threads. The removals are then made one by one, visiting
+    /// the candidates' edges in order as a sequential pass would, with the
+    /// records standing in for the search wherever no earlier removal of the
+    /// pass can have changed the edge's ring.
     fn pass(
         &mut self,
         mesh: &mut TetMesh,
@@ -487,7 +489,6 @@ fn smooth_vertex(
 
 /// Vertex smoothing of dirty movable vertices whose worst tet is poor, colour
 /// class by colour class. Returns the number of vertices moved.
-#[allow(clippy::too_many_arguments)]
 fn smooth_pass(
     mesh: &mut TetMesh,
     tr: &mut Tracker,
@@ -525,21 +526,28 @@ fn smooth_pass(
     let classes = colour_balls_except(&balls, masks, |i| vq[verts[i] as usize] < opts.threshold);
     drop(vq);
     let mut moved = 0;
+    let mut scratch = SmoothScratch::default();
     for class in &classes {
         let moves: Vec<Option<VertexMove>> = {
             let mesh = &*mesh;
             let tq = &tr.tq;
-            class
-                .par_iter()
-                .with_min_len(64)
-                .map_init(SmoothScratch::default, |s, &i| {
-                    let ball = balls.ball(i as usize);
-                    if ball.is_empty() {
-                        return None;
-                    }
-                    smooth_vertex(mesh, tq, verts[i as usize], ball, opts, s)
-                })
-                .collect()
+            let one = |s: &mut SmoothScratch, i: u32| {
+                let ball = balls.ball(i as usize);
+                if ball.is_empty() {
+                    return None;
+                }
+                smooth_vertex(mesh, tq, verts[i as usize], ball, opts, s)
+            };
+            if class.len() < 64 {
+                // Not worth a trip through the thread pool.
+                class.iter().map(|&i| one(&mut scratch, i)).collect()
+            } else {
+                class
+                    .par_iter()
+                    .with_min_len(64)
+                    .map_init(SmoothScratch::default, |s, &i| one(s, i))
+                    .collect()
+            }
         };
         for (&i, m) in class.iter().zip(moves) {
             let Some(m) = m else { continue };
