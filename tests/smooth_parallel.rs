@@ -8,7 +8,7 @@ use std::path::Path;
 use tetrefine::geom::{orient3d, tet_min_sine};
 use tetrefine::io::load_mesh;
 use tetrefine::mesh::generate::cube_grid;
-use tetrefine::smooth::colour::colour_classes;
+use tetrefine::smooth::colour::{colour_balls_except, colour_classes, Balls};
 use tetrefine::smooth::{ball_stays_positive, fixed_vertices, improve, ImproveOptions};
 use tetrefine::TetMesh;
 
@@ -97,6 +97,37 @@ fn colour_classes_of_the_tripod_are_independent_sets() {
             assert!(k <= 1, "tet {t} holds {k} vertices of one class");
         }
     }
+}
+
+#[test]
+fn vertices_set_apart_get_classes_of_their_own_before_and_after() {
+    let (mesh, _) = load_mesh(Path::new("meshes/tripod.mesh")).unwrap();
+    let fixed = fixed_vertices(&mesh);
+    let verts: Vec<u32> = (0..mesh.n_points() as u32)
+        .filter(|&v| !fixed[v as usize] && mesh.tet_of_vertex(v).is_some())
+        .collect();
+    let balls = Balls::gather(&mesh, &verts);
+    let apart: Vec<u32> = (0..verts.len() as u32).filter(|i| i % 7 == 0).collect();
+    let mut masks = Vec::new();
+    let classes = colour_balls_except(&balls, &mut masks, |i| i % 7 == 0);
+    let k = apart.len();
+    let singles = |cs: &[Vec<u32>]| cs.iter().map(|c| c.clone()).collect::<Vec<_>>();
+    let expected: Vec<Vec<u32>> = apart.iter().map(|&i| vec![i]).collect();
+    assert_eq!(singles(&classes[..k]), expected);
+    assert_eq!(singles(&classes[classes.len() - k..]), expected);
+    assert!(masks.iter().all(|&m| m == 0), "scratch left clean");
+    // The classes in between hold every other vertex once, independently.
+    let mut seen = HashSet::new();
+    for c in &classes[k..classes.len() - k] {
+        let mut tets = HashSet::new();
+        for &i in c {
+            assert!(i % 7 != 0 && seen.insert(i));
+            for &t in balls.ball(i as usize) {
+                assert!(tets.insert(t), "tet {t} shared within a class");
+            }
+        }
+    }
+    assert_eq!(seen.len() + k, verts.len());
 }
 
 #[test]

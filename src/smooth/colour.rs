@@ -98,6 +98,10 @@ pub fn colour_balls_except(
     let mut classes: Vec<Vec<u32>> = Vec::new();
     let mut alone = Vec::new();
     let mut crowded = Vec::new();
+    let slots = balls.tets.iter().max().map_or(0, |&t| t as usize + 1);
+    if masks.len() < slots {
+        masks.resize(slots, 0);
+    }
     for i in 0..balls.len() {
         if alone_if(i) {
             alone.push(i as u32);
@@ -106,11 +110,7 @@ pub fn colour_balls_except(
         let ball = balls.ball(i);
         let mut used = 0u64;
         for &t in ball {
-            let t = t as usize;
-            if t >= masks.len() {
-                masks.resize(t + 1, 0);
-            }
-            used |= masks[t];
+            used |= masks[t as usize];
         }
         let c = (!used).trailing_zeros() as usize;
         if c == 64 {
