@@ -111,10 +111,9 @@ fn vertices_set_apart_get_classes_of_their_own_before_and_after() {
     let mut masks = Vec::new();
     let classes = colour_balls_except(&balls, &mut masks, |i| i % 7 == 0);
     let k = apart.len();
-    let singles = |cs: &[Vec<u32>]| cs.iter().map(|c| c.clone()).collect::<Vec<_>>();
     let expected: Vec<Vec<u32>> = apart.iter().map(|&i| vec![i]).collect();
-    assert_eq!(singles(&classes[..k]), expected);
-    assert_eq!(singles(&classes[classes.len() - k..]), expected);
+    assert_eq!(&classes[..k], &expected[..]);
+    assert_eq!(&classes[classes.len() - k..], &expected[..]);
     assert!(masks.iter().all(|&m| m == 0), "scratch left clean");
     // The classes in between hold every other vertex once, independently.
     let mut seen = HashSet::new();

@@ -10,7 +10,7 @@
 //! and its tags are untouched.
 
 use super::colour::{colour_balls_except, Balls};
-use super::laplacian::laplacian_position;
+use super::laplacian::{laplacian_position, BallNow};
 use super::optimize::{optimize_position, OptimizeParams};
 use super::ring::{canonicalize_ring, improving_ring_triangulation, RingScratch};
 use super::tet_points_with;
@@ -448,16 +448,14 @@ fn smooth_vertex(
     let mean = sum / ball.len().max(1) as f64;
     let mut x = mesh.point(v);
     let mut laplacian = false;
-    if let Some((x2, q2)) = laplacian_position(
-        mesh,
-        v,
-        ball,
-        q,
+    let now = BallNow {
+        worst: q,
         mean,
-        worst,
-        &mut s.neighbours,
-        &mut s.qualities,
-    ) {
+        first: worst,
+    };
+    if let Some((x2, q2)) =
+        laplacian_position(mesh, v, ball, now, &mut s.neighbours, &mut s.qualities)
+    {
         x = x2;
         q = q2;
         laplacian = true;

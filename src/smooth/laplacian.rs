@@ -15,30 +15,39 @@ pub fn laplacian_target(mesh: &TetMesh, v: u32, ball: &[u32], scratch: &mut Vec<
     scratch.iter().map(|&u| mesh.point(u)).sum::<DVec3>() / scratch.len() as f64
 }
 
+/// The ball of a vertex as it stands, for [`laplacian_position`].
+#[derive(Clone, Copy, Debug)]
+pub struct BallNow {
+    /// Its worst tet quality.
+    pub worst: f64,
+    /// Its mean tet quality.
+    pub mean: f64,
+    /// Position in the ball of a tet to check first (the worst one; any
+    /// position works, one past the end for none).
+    pub first: usize,
+}
+
 /// Where [`laplacian_smooth`] would move `v`, without moving it: the
 /// Laplacian target and the ball's new worst quality, if the target raises the
-/// worst quality above `current` without lowering the mean below
-/// `current_mean` (the ball's mean quality as it stands) or inverting anything.
-/// `first` is the position in `ball` of a tet to check first (the worst one;
-/// any position works, one past the end for none). On success `qualities`
-/// holds the ball's tet qualities at the target, in `ball` order.
+/// worst quality above `now.worst` without lowering the mean below `now.mean`
+/// or inverting anything. On success `qualities` holds the ball's tet
+/// qualities at the target, in `ball` order.
 pub fn laplacian_position(
     mesh: &TetMesh,
     v: u32,
     ball: &[u32],
-    current: f64,
-    current_mean: f64,
-    first: usize,
+    now: BallNow,
     scratch: &mut Vec<u32>,
     qualities: &mut Vec<f64>,
 ) -> Option<(DVec3, f64)> {
+    let (current, current_mean, first) = (now.worst, now.mean, now.first);
     let x = laplacian_target(mesh, v, ball, scratch);
     // Every tet must end above `current`; any tet at or below it settles the
     // answer, and the likeliest one to be is the one `first` (the caller's
     // worst tet), so it is tried before the others.
     let quality = |t: u32| tet_min_sine(&tet_points_with(mesh, t, v, x));
     let head = ball.get(first).map(|&t| quality(t));
-    if head.is_some_and(|s| !(s > current)) {
+    if head.is_some_and(|s| s.is_nan() || s <= current) {
         return None;
     }
     qualities.clear();
@@ -49,7 +58,7 @@ pub fn laplacian_position(
             Some(h) if i == first => h,
             _ => quality(t),
         };
-        if !(s > current) {
+        if s.is_nan() || s <= current {
             return None;
         }
         q = q.min(s);
@@ -70,17 +79,12 @@ pub fn laplacian_smooth(
     current: f64,
     scratch: &mut Vec<u32>,
 ) -> Option<f64> {
-    let mean = ball_min_mean_at(mesh, v, ball, mesh.point(v)).1;
-    let (x, q) = laplacian_position(
-        mesh,
-        v,
-        ball,
-        current,
-        mean,
-        usize::MAX,
-        scratch,
-        &mut Vec::new(),
-    )?;
+    let now = BallNow {
+        worst: current,
+        mean: ball_min_mean_at(mesh, v, ball, mesh.point(v)).1,
+        first: usize::MAX,
+    };
+    let (x, q) = laplacian_position(mesh, v, ball, now, scratch, &mut Vec::new())?;
     mesh.set_point(v, x);
     Some(q)
 }
