@@ -9,12 +9,19 @@
 //! (closed rings inside one region) are removed, so the domain, its regions
 //! and its tags are untouched.
 
-use super::laplacian::laplacian_smooth;
-use super::optimize::{optimize_vertex, OptimizeParams};
+use super::colour::{colour_balls_except, Balls};
+use super::laplacian::{laplacian_position, BallNow};
+use super::optimize::{optimize_position, OptimizeParams};
+use super::ring::{canonicalize_ring, improving_ring_triangulation, RingScratch};
+use super::tet_points_with;
 use crate::geom::{tet_min_sine, TET_EDGES};
-use crate::mesh::fasthash::FastHashSet;
-use crate::mesh::{edge_key, TetMarks, TetMesh, NO_ADJ};
-use crate::ops::{remove_edge, EdgeRing};
+use crate::mesh::fasthash::{FastHashMap, FastHashSet};
+use crate::mesh::{edge_key, EdgeKey, TetMesh, NO_ADJ};
+use crate::ops::edge_removal::{apply_ring_triangulation, RingTriangulation};
+use crate::ops::EdgeRing;
+use glam::DVec3;
+use rayon::prelude::*;
+use std::sync::atomic::{AtomicU8, Ordering};
 
 /// Options of [`improve`].
 #[derive(Clone, Debug)]
@@ -109,6 +116,8 @@ struct Tracker {
 impl Tracker {
     fn new(mesh: &TetMesh, allowed: Option<Vec<bool>>) -> Tracker {
         let tq = (0..mesh.n_tet_slots() as u32)
+            .into_par_iter()
+            .with_min_len(4096)
             .map(|t| {
                 if mesh.is_alive(t) {
                     tet_min_sine(&mesh.tet_points(t))
@@ -135,10 +144,9 @@ impl Tracker {
         }
     }
 
-    /// Refreshes the quality of `t` and flags it and its vertices.
-    fn touch(&mut self, mesh: &TetMesh, t: u32) {
-        self.grow(mesh.n_tet_slots());
-        self.tq[t as usize] = tet_min_sine(&mesh.tet_points(t));
+    /// Records quality `q` for `t` and flags it and its vertices.
+    fn set(&mut self, mesh: &TetMesh, t: u32, q: f64) {
+        self.tq[t as usize] = q;
         self.tet_dirty[t as usize] = true;
         for v in mesh.tet(t) {
             self.vert_dirty[v as usize] = true;
@@ -152,123 +160,404 @@ impl Tracker {
     }
 }
 
+/// Local edge index (into [`TET_EDGES`]) of local vertices `i != j`.
+const EDGE_OF: [[u8; 4]; 4] = [[6, 0, 1, 2], [0, 6, 3, 4], [1, 3, 6, 5], [2, 4, 5, 6]];
+
 /// Runs the optimisation passes on `mesh`.
+///
+/// The edge search and vertex smoothing run in parallel: edges are searched
+/// on the mesh as it stands and removed in order (see `EdgeRemoval::pass`),
+/// vertices are smoothed by colour classes, independent sets smoothed in
+/// parallel (see [`super::colour`]). The result does not depend on the
+/// number of threads.
 pub fn improve(mesh: &mut TetMesh, opts: &ImproveOptions) -> ImproveReport {
     let fixed = fixed_vertices(mesh);
+    let movable: Vec<bool> = (0..mesh.n_points())
+        .map(|v| {
+            !fixed[v]
+                && opts
+                    .movable
+                    .as_ref()
+                    .is_none_or(|m| m.get(v).copied().unwrap_or(false))
+        })
+        .collect();
+    drop(fixed);
     let mut report = ImproveReport::default();
-    let mut ring = EdgeRing::default();
-    let mut ball = Vec::new();
-    let mut scratch = Vec::new();
-    let mut marks = TetMarks::default();
-    let params = OptimizeParams::default();
     let mut tr = Tracker::new(mesh, opts.tet_allowed.clone());
-    let movable = |v: u32| {
-        !fixed[v as usize]
-            && opts
-                .movable
-                .as_ref()
-                .is_none_or(|m| m.get(v as usize).copied().unwrap_or(false))
-    };
+    let mut edges = EdgeRemoval::default();
+    let mut masks = Vec::new();
     for _ in 0..opts.passes {
         report.passes += 1;
-        let mut changed = 0;
+        let mut changed = edges.pass(mesh, &mut tr, opts, &mut report);
+        changed += smooth_pass(mesh, &mut tr, &movable, opts, &mut masks, &mut report);
+        if changed == 0 {
+            break;
+        }
+    }
+    report
+}
 
-        // Interior edge removal, on the edges of dirty low-quality tets, each
-        // edge tried once per pass.
+/// A removable edge found by the search half of an edge removal pass.
+struct Removable {
+    ring: EdgeRing,
+    tri: RingTriangulation,
+}
+
+/// Buffers of the edge removal passes.
+#[derive(Default)]
+struct EdgeRemoval {
+    /// Per tet slot, bit `e`: local edge `e` was tried in this pass.
+    tried: Vec<AtomicU8>,
+    /// Per tet slot: in the ring of a recorded removable edge.
+    has_found: Vec<bool>,
+    /// Per point: a vertex of a cavity re-triangulated in this pass.
+    touched: Vec<bool>,
+}
+
+/// Per-thread buffers of the edge search.
+#[derive(Default)]
+struct EdgeScratch {
+    ring: EdgeRing,
+    dp: RingScratch,
+}
+
+impl EdgeRemoval {
+    /// Interior edge removal on the edges of dirty low-quality tets, each edge
+    /// tried once per pass. Returns the number of edges removed.
+    ///
+    /// The search runs in parallel on the mesh as it stands: every edge of a
+    /// candidate tet whose closed ring can be re-triangulated with a better
+    /// worst tet (see [`improving_ring_triangulation`]) is recorded with its
+    /// triangulation. Whichever thread finds an edge, its ring is put in
+    /// canonical form first ([`canonicalize_ring`]), so the records do not
+    /// depend on the threads. The removals are then made one by one, visiting
+    /// the candidates' edges in order as a sequential pass would, with the
+    /// records standing in for the search wherever no earlier removal of the
+    /// pass can have changed the edge's ring.
+    fn pass(
+        &mut self,
+        mesh: &mut TetMesh,
+        tr: &mut Tracker,
+        opts: &ImproveOptions,
+        report: &mut ImproveReport,
+    ) -> usize {
         let candidates: Vec<u32> = (0..mesh.n_tet_slots() as u32)
+            .into_par_iter()
+            .with_min_len(4096)
             .filter(|&t| {
                 let i = t as usize;
-                mesh.is_alive(t)
-                    && tr.tet_dirty[i]
+                tr.tet_dirty[i]
                     && tr.tq[i] < opts.edge_threshold
+                    && mesh.is_alive(t)
                     && tr.is_allowed(t)
             })
             .collect();
         for &t in &candidates {
             tr.tet_dirty[t as usize] = false;
         }
-        let mut tried: FastHashSet<[u32; 2]> =
-            FastHashSet::with_capacity_and_hasher(4 * candidates.len(), Default::default());
+        self.tried.clear();
+        self.tried
+            .resize_with(mesh.n_tet_slots(), || AtomicU8::new(0));
+        let found: Vec<Removable> = {
+            let mesh = &*mesh;
+            let tr = &*tr;
+            let tried = &self.tried;
+            candidates
+                .par_chunks(256)
+                .map_init(EdgeScratch::default, |s, chunk| {
+                    let mut found = Vec::new();
+                    for &t in chunk {
+                        search_tet(mesh, tr, tried, opts, t, s, &mut found);
+                    }
+                    found
+                })
+                .flatten_iter()
+                .collect()
+        };
+        // The records by edge; two threads may have found the same edge at
+        // once (same record). `has_found` flags the tets of their rings.
+        self.has_found.clear();
+        self.has_found.resize(mesh.n_tet_slots(), false);
+        let mut by_edge: FastHashMap<EdgeKey, Removable> =
+            FastHashMap::with_capacity_and_hasher(found.len(), Default::default());
+        for f in found {
+            for &u in &f.ring.tets {
+                self.has_found[u as usize] = true;
+            }
+            by_edge.insert(edge_key(f.ring.a, f.ring.b), f);
+        }
+        // Apply, visiting the candidates' edges in order as a sequential pass
+        // would. Removing an edge changes only tets whose vertices are all in
+        // its cavity, so the ring of an edge with an end outside every cavity
+        // so far is still the one the search saw: its record (or the lack of
+        // one) stands. Edges with both ends touched are searched again.
+        self.touched.clear();
+        self.touched.resize(mesh.n_points(), false);
+        let mut retried: FastHashSet<EdgeKey> = FastHashSet::default();
+        let mut removed = 0;
+        let mut scratch = EdgeScratch::default();
         for t in candidates {
             if !mesh.is_alive(t) || tr.tq[t as usize] >= opts.edge_threshold {
                 continue;
             }
             let v = mesh.tet(t);
-            for (e, [i, j]) in TET_EDGES.iter().enumerate() {
-                if !tried.insert(edge_key(v[*i], v[*j])) || mesh.is_feature_edge(v[*i], v[*j]) {
-                    continue;
-                }
-                ring.gather_into(mesh, t, e);
-                if !ring.closed
-                    || ring.tets.len() > opts.max_ring
-                    || !ring.tets.iter().all(|&u| tr.is_allowed(u))
-                {
-                    continue;
-                }
-                let worst = ring
-                    .tets
-                    .iter()
-                    .map(|&u| tr.tq[u as usize])
-                    .fold(f64::INFINITY, f64::min);
-                if let Ok(new) = remove_edge(mesh, &ring, worst + 1e-12) {
-                    changed += 1;
-                    report.edges_removed += 1;
-                    for n in new {
-                        tr.touch(mesh, n);
-                        if let Some(a) = &mut tr.allowed {
-                            a[n as usize] = true;
-                        }
+            for (e, &[i, j]) in TET_EDGES.iter().enumerate() {
+                let key = edge_key(v[i], v[j]);
+                let rec = if self.touched[v[i] as usize] && self.touched[v[j] as usize] {
+                    if !retried.insert(key) || mesh.is_feature_edge(v[i], v[j]) {
+                        continue;
                     }
-                    break; // t is gone
+                    search_edge(mesh, tr, opts, t, e, &mut scratch)
+                } else if (t as usize) < self.has_found.len() && self.has_found[t as usize] {
+                    by_edge.remove(&key)
+                } else {
+                    None
+                };
+                let Some(f) = rec else { continue };
+                let Ok(new) = apply_ring_triangulation(mesh, &f.ring, &f.tri) else {
+                    continue;
+                };
+                removed += 1;
+                let slots = mesh.n_tet_slots();
+                tr.grow(slots);
+                for &x in f.ring.verts.iter().chain([&f.ring.a, &f.ring.b]) {
+                    self.touched[x as usize] = true;
                 }
+                for n in new {
+                    let q = tet_min_sine(&mesh.tet_points(n));
+                    tr.set(mesh, n, q);
+                    if let Some(a) = &mut tr.allowed {
+                        a[n as usize] = true;
+                    }
+                }
+                break; // t is gone
             }
         }
+        report.edges_removed += removed;
+        removed
+    }
+}
 
-        // Vertex smoothing of dirty vertices whose worst tet is poor.
-        let mut vq = vec![f64::INFINITY; mesh.n_points()];
-        for t in mesh.tet_ids() {
-            let q = tr.tq[t as usize];
-            for x in mesh.tet(t) {
+/// Gathers the ring of local edge `e` of `t` into `s.ring` and, if it is a
+/// closed ring of allowed tets that can be re-triangulated with a better worst
+/// tet, returns it in canonical form with its triangulation.
+fn search_edge(
+    mesh: &TetMesh,
+    tr: &Tracker,
+    opts: &ImproveOptions,
+    t: u32,
+    e: usize,
+    s: &mut EdgeScratch,
+) -> Option<Removable> {
+    let ring = &mut s.ring;
+    ring.gather_into(mesh, t, e);
+    if !ring.closed
+        || ring.tets.len() > opts.max_ring
+        || !ring.tets.iter().all(|&u| tr.is_allowed(u))
+    {
+        return None;
+    }
+    let worst = ring
+        .tets
+        .iter()
+        .map(|&u| tr.tq[u as usize])
+        .fold(f64::INFINITY, f64::min);
+    canonicalize_ring(ring);
+    let tri = improving_ring_triangulation(mesh, ring, worst + 1e-12, &mut s.dp)?;
+    Some(Removable {
+        ring: ring.clone(),
+        tri,
+    })
+}
+
+/// The search half of [`EdgeRemoval::pass`] for the edges of candidate tet
+/// `t` not tried yet: appends the removable ones to `found`.
+fn search_tet(
+    mesh: &TetMesh,
+    tr: &Tracker,
+    tried: &[AtomicU8],
+    opts: &ImproveOptions,
+    t: u32,
+    s: &mut EdgeScratch,
+    found: &mut Vec<Removable>,
+) {
+    let v = mesh.tet(t);
+    for (e, &[i, j]) in TET_EDGES.iter().enumerate() {
+        if tried[t as usize].fetch_or(1 << e, Ordering::Relaxed) & (1 << e) != 0
+            || mesh.is_feature_edge(v[i], v[j])
+        {
+            continue;
+        }
+        let rec = search_edge(mesh, tr, opts, t, e, s);
+        // Every tet of the ring holds the edge: it is tried now.
+        for &u in &s.ring.tets {
+            let uv = mesh.tet(u);
+            let ia = uv.iter().position(|&x| x == s.ring.a).unwrap_or(0);
+            let ib = uv.iter().position(|&x| x == s.ring.b).unwrap_or(1);
+            let k = EDGE_OF[ia][ib];
+            if k < 6 {
+                tried[u as usize].fetch_or(1 << k, Ordering::Relaxed);
+            }
+        }
+        found.extend(rec);
+    }
+}
+
+/// Per-thread buffers of vertex smoothing.
+#[derive(Default)]
+struct SmoothScratch {
+    neighbours: Vec<u32>,
+    qualities: Vec<f64>,
+}
+
+/// A vertex move decided by [`smooth_vertex`].
+struct VertexMove {
+    /// New position.
+    x: DVec3,
+    /// Moved by Laplacian smoothing.
+    laplacian: bool,
+    /// Moved by optimization-based smoothing.
+    optimized: bool,
+    /// Qualities of the ball's tets at `x`, in ball order.
+    qualities: Vec<f64>,
+}
+
+/// The move of `v` (ball `ball`, per-slot qualities `tq`): a Laplacian try
+/// kept only if it raises the worst tet and keeps the mean, then
+/// optimization-based smoothing if the worst tet is still below the
+/// threshold. Reads only the ball's points and qualities.
+fn smooth_vertex(
+    mesh: &TetMesh,
+    tq: &[f64],
+    v: u32,
+    ball: &[u32],
+    opts: &ImproveOptions,
+    s: &mut SmoothScratch,
+) -> Option<VertexMove> {
+    let mut q = f64::INFINITY;
+    let mut worst = 0;
+    let mut sum = 0.0;
+    for (i, &t) in ball.iter().enumerate() {
+        let qt = tq[t as usize];
+        if qt < q {
+            q = qt;
+            worst = i;
+        }
+        sum += qt;
+    }
+    let mean = sum / ball.len().max(1) as f64;
+    let mut x = mesh.point(v);
+    let mut laplacian = false;
+    let now = BallNow {
+        worst: q,
+        mean,
+        first: worst,
+    };
+    if let Some((x2, q2)) =
+        laplacian_position(mesh, v, ball, now, &mut s.neighbours, &mut s.qualities)
+    {
+        x = x2;
+        q = q2;
+        laplacian = true;
+    }
+    let mut optimized = false;
+    if q < opts.threshold {
+        if let Some((x3, _)) = optimize_position(mesh, v, x, ball, &OptimizeParams::default()) {
+            x = x3;
+            optimized = true;
+        }
+    }
+    if !(laplacian || optimized) {
+        return None;
+    }
+    let qualities = if optimized {
+        ball.iter()
+            .map(|&t| tet_min_sine(&tet_points_with(mesh, t, v, x)))
+            .collect()
+    } else {
+        s.qualities.clone()
+    };
+    Some(VertexMove {
+        x,
+        laplacian,
+        optimized,
+        qualities,
+    })
+}
+
+/// Vertex smoothing of dirty movable vertices whose worst tet is poor, colour
+/// class by colour class. Returns the number of vertices moved.
+fn smooth_pass(
+    mesh: &mut TetMesh,
+    tr: &mut Tracker,
+    movable: &[bool],
+    opts: &ImproveOptions,
+    masks: &mut Vec<u64>,
+    report: &mut ImproveReport,
+) -> usize {
+    let mut vq = vec![f64::INFINITY; mesh.n_points()];
+    for (t, tv) in mesh.tet_slots().iter().enumerate() {
+        let q = tr.tq[t];
+        if q.is_finite() && mesh.is_alive(t as u32) {
+            for &x in tv {
                 let s = &mut vq[x as usize];
                 *s = s.min(q);
             }
         }
-        for v in 0..mesh.n_points() as u32 {
-            if !tr.vert_dirty[v as usize] || !movable(v) {
-                continue;
-            }
-            tr.vert_dirty[v as usize] = false;
-            if vq[v as usize] >= opts.threshold.max(opts.laplacian_threshold) {
-                continue;
-            }
-            mesh.ball_marked(v, &mut ball, &mut marks);
-            if ball.is_empty() {
-                continue;
-            }
-            let mut q = ball
-                .iter()
-                .map(|&t| tr.tq[t as usize])
-                .fold(f64::INFINITY, f64::min);
-            let mut moved = false;
-            if let Some(q2) = laplacian_smooth(mesh, v, &ball, q, &mut scratch) {
-                q = q2;
-                moved = true;
-                report.laplacian_moves += 1;
-            }
-            if q < opts.threshold && optimize_vertex(mesh, v, &ball, &params).is_some() {
-                moved = true;
-                report.optimized_moves += 1;
-            }
-            if moved {
-                changed += 1;
-                for &t in &ball {
-                    tr.touch(mesh, t);
-                }
-            }
+    }
+    let bar = opts.threshold.max(opts.laplacian_threshold);
+    let mut verts = Vec::new();
+    for v in 0..mesh.n_points() {
+        if !tr.vert_dirty[v] || !movable[v] {
+            continue;
         }
-        if changed == 0 {
-            break;
+        tr.vert_dirty[v] = false;
+        if vq[v] < bar {
+            verts.push(v as u32);
         }
     }
-    report
+    let balls = Balls::gather(mesh, &verts);
+    // The vertices bad enough for optimization-based smoothing are few, and
+    // the worst tets hinge on them: they are smoothed one by one in vertex
+    // order before and after the colour classes (smoothing them only in
+    // colour order lost up to 4.5° of the tripod's worst angle).
+    let classes = colour_balls_except(&balls, masks, |i| vq[verts[i] as usize] < opts.threshold);
+    drop(vq);
+    let mut moved = 0;
+    let mut scratch = SmoothScratch::default();
+    for class in &classes {
+        let moves: Vec<Option<VertexMove>> = {
+            let mesh = &*mesh;
+            let tq = &tr.tq;
+            let one = |s: &mut SmoothScratch, i: u32| {
+                let ball = balls.ball(i as usize);
+                if ball.is_empty() {
+                    return None;
+                }
+                smooth_vertex(mesh, tq, verts[i as usize], ball, opts, s)
+            };
+            if class.len() < 64 {
+                // Not worth a trip through the thread pool.
+                class.iter().map(|&i| one(&mut scratch, i)).collect()
+            } else {
+                class
+                    .par_iter()
+                    .with_min_len(64)
+                    .map_init(SmoothScratch::default, |s, &i| one(s, i))
+                    .collect()
+            }
+        };
+        for (&i, m) in class.iter().zip(moves) {
+            let Some(m) = m else { continue };
+            let v = verts[i as usize];
+            mesh.set_point(v, m.x);
+            for (&t, &q) in balls.ball(i as usize).iter().zip(&m.qualities) {
+                tr.set(mesh, t, q);
+            }
+            moved += 1;
+            report.laplacian_moves += m.laplacian as usize;
+            report.optimized_moves += m.optimized as usize;
+        }
+    }
+    moved
 }

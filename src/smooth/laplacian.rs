@@ -1,7 +1,8 @@
 //! Laplacian smoothing: the vertex goes to the centroid of its neighbours
 //! (Field 1988), kept only if the worst tet of its ball improves.
 
-use super::{ball_min_mean_at, ball_stays_positive, vertex_neighbours};
+use super::{ball_min_mean_at, ball_stays_positive, tet_points_with, vertex_neighbours};
+use crate::geom::tet_min_sine;
 use crate::mesh::TetMesh;
 use glam::DVec3;
 
@@ -14,6 +15,60 @@ pub fn laplacian_target(mesh: &TetMesh, v: u32, ball: &[u32], scratch: &mut Vec<
     scratch.iter().map(|&u| mesh.point(u)).sum::<DVec3>() / scratch.len() as f64
 }
 
+/// The ball of a vertex as it stands, for [`laplacian_position`].
+#[derive(Clone, Copy, Debug)]
+pub struct BallNow {
+    /// Its worst tet quality.
+    pub worst: f64,
+    /// Its mean tet quality.
+    pub mean: f64,
+    /// Position in the ball of a tet to check first (the worst one; any
+    /// position works, one past the end for none).
+    pub first: usize,
+}
+
+/// Where [`laplacian_smooth`] would move `v`, without moving it: the
+/// Laplacian target and the ball's new worst quality, if the target raises the
+/// worst quality above `now.worst` without lowering the mean below `now.mean`
+/// or inverting anything. On success `qualities` holds the ball's tet
+/// qualities at the target, in `ball` order.
+pub fn laplacian_position(
+    mesh: &TetMesh,
+    v: u32,
+    ball: &[u32],
+    now: BallNow,
+    scratch: &mut Vec<u32>,
+    qualities: &mut Vec<f64>,
+) -> Option<(DVec3, f64)> {
+    let (current, current_mean, first) = (now.worst, now.mean, now.first);
+    let x = laplacian_target(mesh, v, ball, scratch);
+    // Every tet must end above `current`; any tet at or below it settles the
+    // answer, and the likeliest one to be is the one `first` (the caller's
+    // worst tet), so it is tried before the others.
+    let quality = |t: u32| tet_min_sine(&tet_points_with(mesh, t, v, x));
+    let head = ball.get(first).map(|&t| quality(t));
+    if head.is_some_and(|s| s.is_nan() || s <= current) {
+        return None;
+    }
+    qualities.clear();
+    let mut q = f64::INFINITY;
+    let mut sum = 0.0;
+    for (i, &t) in ball.iter().enumerate() {
+        let s = match head {
+            Some(h) if i == first => h,
+            _ => quality(t),
+        };
+        if s.is_nan() || s <= current {
+            return None;
+        }
+        q = q.min(s);
+        sum += s;
+        qualities.push(s);
+    }
+    let mean = sum / ball.len().max(1) as f64;
+    (mean >= current_mean && ball_stays_positive(mesh, v, ball, x)).then_some((x, q))
+}
+
 /// Moves `v` to its Laplacian target if that raises the ball's worst quality
 /// above `current` without lowering the ball's mean quality or inverting
 /// anything. Returns the new worst quality if it moved.
@@ -24,15 +79,12 @@ pub fn laplacian_smooth(
     current: f64,
     scratch: &mut Vec<u32>,
 ) -> Option<f64> {
-    let x = laplacian_target(mesh, v, ball, scratch);
-    let (q, mean) = ball_min_mean_at(mesh, v, ball, x);
-    if q > current
-        && mean >= ball_min_mean_at(mesh, v, ball, mesh.point(v)).1
-        && ball_stays_positive(mesh, v, ball, x)
-    {
-        mesh.set_point(v, x);
-        Some(q)
-    } else {
-        None
-    }
+    let now = BallNow {
+        worst: current,
+        mean: ball_min_mean_at(mesh, v, ball, mesh.point(v)).1,
+        first: usize::MAX,
+    };
+    let (x, q) = laplacian_position(mesh, v, ball, now, scratch, &mut Vec::new())?;
+    mesh.set_point(v, x);
+    Some(q)
 }

@@ -4,15 +4,18 @@
 //! The objective everywhere is the paper's quality: the minimum signed sine of
 //! the dihedral angles of a tet, and for a vertex the minimum over its ball.
 
+pub mod colour;
 pub mod improve;
 pub mod laplacian;
 pub mod optimize;
+pub mod ring;
 
 pub use improve::{fixed_vertices, improve, ImproveOptions, ImproveReport};
 
 use crate::geom::{orient3d, tet_min_sine};
 use crate::mesh::TetMesh;
 use glam::DVec3;
+use std::cell::RefCell;
 
 /// The corners of tet `t` with vertex `v` (if it is one of them) standing at `x`.
 #[inline]
@@ -67,14 +70,32 @@ pub fn ball_stays_positive(mesh: &TetMesh, v: u32, ball: &[u32], x: DVec3) -> bo
 }
 
 /// The distinct vertices adjacent to `v` (sharing a tet with it), appended to
-/// `out` (cleared first).
+/// `out` (cleared first) in the order they first appear in `ball`.
 pub fn vertex_neighbours(mesh: &TetMesh, v: u32, ball: &[u32], out: &mut Vec<u32>) {
+    thread_local! {
+        /// Per-thread "seen in this call" stamps, one per point.
+        static SEEN: RefCell<(Vec<u32>, u32)> = const { RefCell::new((Vec::new(), 0)) };
+    }
     out.clear();
-    for &t in ball {
-        for x in mesh.tet(t) {
-            if x != v && !out.contains(&x) {
-                out.push(x);
+    SEEN.with(|seen| {
+        let (stamp, epoch) = &mut *seen.borrow_mut();
+        if stamp.len() < mesh.n_points() {
+            stamp.resize(mesh.n_points(), 0);
+        }
+        *epoch = epoch.wrapping_add(1);
+        if *epoch == 0 {
+            stamp.iter_mut().for_each(|s| *s = 0);
+            *epoch = 1;
+        }
+        stamp[v as usize] = *epoch;
+        for &t in ball {
+            for x in mesh.tet(t) {
+                let s = &mut stamp[x as usize];
+                if *s != *epoch {
+                    *s = *epoch;
+                    out.push(x);
+                }
             }
         }
-    }
+    });
 }

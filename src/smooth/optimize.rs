@@ -77,7 +77,21 @@ pub fn optimize_vertex(
     ball: &[u32],
     params: &OptimizeParams,
 ) -> Option<f64> {
-    let x0 = mesh.point(v);
+    let (x, q) = optimize_position(mesh, v, mesh.point(v), ball, params)?;
+    mesh.set_point(v, x);
+    Some(q)
+}
+
+/// Where [`optimize_vertex`] would move `v` if it stood at `x0`, without
+/// moving it: the optimised position and the ball's new minimum quality, if
+/// that is above the minimum at `x0`.
+pub fn optimize_position(
+    mesh: &TetMesh,
+    v: u32,
+    x0: DVec3,
+    ball: &[u32],
+    params: &OptimizeParams,
+) -> Option<(DVec3, f64)> {
     // A length scale for differences and steps: mean distance to the ball's
     // other vertices.
     let mut scale = 0.0;
@@ -155,10 +169,5 @@ pub fn optimize_vertex(
             break;
         }
     }
-    if q > start {
-        mesh.set_point(v, x);
-        Some(q)
-    } else {
-        None
-    }
+    (q > start).then_some((x, q))
 }
