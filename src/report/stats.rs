@@ -296,7 +296,7 @@ impl Sweep<'_> {
     #[inline(always)]
     fn chunk_body(&self, lo: usize, hi: usize, tets_at: &mut [u32]) -> Acc {
         let mut a = Acc::new(self.histogram.counts.len());
-        let mut batch = [0usize; LANES];
+        let mut batch = [[0u32; 4]; LANES];
         let mut in_batch = 0;
         for t in lo..hi {
             let v = self.tets[t];
@@ -315,7 +315,7 @@ impl Sweep<'_> {
                 }
             }
             a.regions.add(self.region[t]);
-            batch[in_batch] = t;
+            batch[in_batch] = v;
             in_batch += 1;
             if in_batch == LANES {
                 self.add_tets(&mut a, &batch);
@@ -331,25 +331,27 @@ impl Sweep<'_> {
     /// Adds the angles, volume and inversion of up to [`LANES`] live tets, in
     /// the order given (so that the sums do not depend on the batching).
     #[inline(always)]
-    fn add_tets(&self, a: &mut Acc, batch: &[usize]) {
-        let (tets, points) = (self.tets, self.points);
+    fn add_tets(&self, a: &mut Acc, batch: &[[u32; 4]]) {
+        let points = self.points;
+        // The last tet repeated to fill the batch.
+        let ids: [[u32; 4]; LANES] = std::array::from_fn(|i| batch[i.min(batch.len() - 1)]);
         let corner = |j: usize| {
-            let q = |i: usize| points[tets[batch[i.min(batch.len() - 1)]][j] as usize];
+            let q: [DVec3; LANES] = std::array::from_fn(|i| points[ids[i][j] as usize]);
             LaneVec {
-                x: lanes(|i| q(i).x),
-                y: lanes(|i| q(i).y),
-                z: lanes(|i| q(i).z),
+                x: lanes(|i| q[i].x),
+                y: lanes(|i| q[i].y),
+                z: lanes(|i| q[i].z),
             }
         };
         let c = cosine_extremes(&[corner(0), corner(1), corner(2), corner(3)]);
         let lo = angles::acos_deg(c.max_cos);
         let hi = angles::acos_deg(c.min_cos);
-        for (i, &t) in batch.iter().enumerate() {
+        let estimate = self.thresholds.estimates(lo);
+        for (i, v) in batch.iter().enumerate() {
             a.tets += 1;
             a.volume += c.d[i] / 6.0;
-            a.inverted += is_inverted(c.d[i], c.edge_product[i], || {
-                tets[t].map(|k| points[k as usize])
-            }) as usize;
+            a.inverted +=
+                is_inverted(c.d[i], c.edge_product[i], || v.map(|k| points[k as usize])) as usize;
             if c.proper[i] && c.d[i] >= 0.0 {
                 a.ordinary += 1;
                 a.max_max_cos = a.max_max_cos.max(c.max_cos[i]);
@@ -357,8 +359,7 @@ impl Sweep<'_> {
                 a.min_min_cos = a.min_min_cos.min(c.min_cos[i]);
                 a.min_sum += lo[i];
                 a.max_sum += hi[i];
-                let estimate = self.histogram.bin(lo[i]);
-                a.hist[self.thresholds.bin(c.max_cos[i], estimate)] += 1;
+                a.hist[self.thresholds.bin(c.max_cos[i], estimate[i])] += 1;
             } else {
                 // The conventions of tet_quality: 0/180 for a face of zero
                 // area, the angles negated and swapped for an inverted tet.

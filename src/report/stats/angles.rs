@@ -168,28 +168,33 @@ const Q_S4: f64 = 7.703_815_055_590_193_527_91e-2;
 #[inline(always)]
 pub(super) fn acos_deg(x: Lanes) -> Lanes {
     use std::f64::consts::{FRAC_PI_2, PI};
-    lanes(|i| {
-        let x = x[i].clamp(-1.0, 1.0);
-        let a = x.abs();
-        let big = a > 0.5;
-        let z = if big { (1.0 - a) * 0.5 } else { x * x };
-        let s = if big { z.sqrt() } else { a };
-        let p = z * (P_S0 + z * (P_S1 + z * (P_S2 + z * (P_S3 + z * (P_S4 + z * P_S5)))));
-        let q = 1.0 + z * (Q_S1 + z * (Q_S2 + z * (Q_S3 + z * Q_S4)));
-        let asin_s = s + s * (p / q);
-        let rad = if big {
-            if x > 0.0 {
-                2.0 * asin_s
-            } else {
-                PI - 2.0 * asin_s
-            }
-        } else if x > 0.0 {
-            FRAC_PI_2 - asin_s
-        } else {
-            FRAC_PI_2 + asin_s
-        };
-        rad.to_degrees()
-    })
+    // One operation at a time across the lanes, selects instead of branches,
+    // so that each line becomes one vector instruction.
+    let x = lanes(|i| x[i].max(-1.0).min(1.0));
+    let a = lanes(|i| x[i].abs());
+    let big = std::array::from_fn::<bool, LANES, _>(|i| a[i] > 0.5);
+    let z_big = lanes(|i| (1.0 - a[i]) * 0.5);
+    let z = lanes(|i| if big[i] { z_big[i] } else { x[i] * x[i] });
+    let root = lanes(|i| z_big[i].sqrt());
+    let s = lanes(|i| if big[i] { root[i] } else { a[i] });
+    let p = lanes(|i| {
+        let z = z[i];
+        z * (P_S0 + z * (P_S1 + z * (P_S2 + z * (P_S3 + z * (P_S4 + z * P_S5)))))
+    });
+    let q = lanes(|i| {
+        let z = z[i];
+        1.0 + z * (Q_S1 + z * (Q_S2 + z * (Q_S3 + z * Q_S4)))
+    });
+    let asin_s = lanes(|i| s[i] + s[i] * (p[i] / q[i]));
+    let twice = lanes(|i| 2.0 * asin_s[i]);
+    let positive = std::array::from_fn::<bool, LANES, _>(|i| x[i] > 0.0);
+    let rad = lanes(|i| match (big[i], positive[i]) {
+        (true, true) => twice[i],
+        (true, false) => PI - twice[i],
+        (false, true) => FRAC_PI_2 - asin_s[i],
+        (false, false) => FRAC_PI_2 + asin_s[i],
+    });
+    lanes(|i| rad[i].to_degrees())
 }
 
 /// The histogram bin of a tet as a function of its largest cosine `c`:
@@ -205,6 +210,9 @@ pub(super) struct BinThresholds {
     /// `tau[k]` for `k = 0..=n`; `tau[0] = +∞` and `tau[n] = -∞` (no cosine
     /// reaches bin `n`).
     tau: Vec<f64>,
+    /// The histogram's lower end and bins per degree, for first guesses.
+    lo_deg: f64,
+    per_deg: f64,
 }
 
 /// Position of `x` in the order of the floats (monotone, for bisection).
@@ -279,7 +287,21 @@ impl BinThresholds {
             }
             *t = key_float(a);
         }
-        BinThresholds { tau }
+        let (lo_deg, hi_deg) = (histogram.edges_deg[0], histogram.edges_deg[n]);
+        let per_deg = n as f64 / (hi_deg - lo_deg);
+        BinThresholds {
+            tau,
+            lo_deg,
+            per_deg: if per_deg.is_finite() { per_deg } else { 0.0 },
+        }
+    }
+
+    /// First guesses of the bins of angles `deg` (close to the exact angles),
+    /// for [`BinThresholds::bin`]; any value is correct, a close one is fast.
+    #[inline(always)]
+    pub fn estimates(&self, deg: Lanes) -> [usize; LANES] {
+        let y = lanes(|i| ((deg[i] - self.lo_deg) * self.per_deg).max(0.0));
+        std::array::from_fn(|i| y[i] as u32 as usize)
     }
 
     /// Bin of largest cosine `c`, starting the search from bin `estimate`
