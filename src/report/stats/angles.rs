@@ -121,8 +121,12 @@ pub(super) fn cosine_extremes(p: &[LaneVec; 4]) -> CosineExtremes {
         for i in 0..LANES {
             let s = inv[k][i] * inv[l][i];
             let cos = -dot[i] * s;
-            max_cos[i] = max_cos[i].max(cos);
-            min_cos[i] = min_cos[i].min(cos);
+            // f64::max/min of tet_quality, written as selects (one vector
+            // instruction each): the same results, as the running extremes
+            // start at ∓∞ and never become NaN, and a NaN cosine is skipped
+            // by both forms.
+            max_cos[i] = if cos > max_cos[i] { cos } else { max_cos[i] };
+            min_cos[i] = if cos < min_cos[i] { cos } else { min_cos[i] };
         }
     }
     let proper = std::array::from_fn(|i| (0..4).all(|f| inv[f][i].is_finite()));
@@ -170,7 +174,15 @@ pub(super) fn acos_deg(x: Lanes) -> Lanes {
     use std::f64::consts::{FRAC_PI_2, PI};
     // One operation at a time across the lanes, selects instead of branches,
     // so that each line becomes one vector instruction.
-    let x = lanes(|i| x[i].max(-1.0).min(1.0));
+    // Clamped as by f64::clamp (a NaN stays NaN), in selects.
+    let x = lanes(|i| {
+        let x = if x[i] < -1.0 { -1.0 } else { x[i] };
+        if x > 1.0 {
+            1.0
+        } else {
+            x
+        }
+    });
     let a = lanes(|i| x[i].abs());
     let big = std::array::from_fn::<bool, LANES, _>(|i| a[i] > 0.5);
     let z_big = lanes(|i| (1.0 - a[i]) * 0.5);
