@@ -20,6 +20,7 @@
 
 use crate::geom::TET_EDGE_OPPOSITE;
 use crate::report::stats::Histogram;
+use std::cmp::Ordering;
 
 /// Tets whose angles are computed side by side.
 pub(super) const LANES: usize = 4;
@@ -148,16 +149,28 @@ pub(super) fn exact_deg(c: f64) -> f64 {
 
 // The rational approximation asin(s) ≈ s + s·z·P(z)/Q(z), z = s², of fdlibm's
 // e_asin.c / e_acos.c (Sun Microsystems, 1993), with its published
-// coefficients; on 0 ≤ s ≤ 1/2 its error is below 2^-58.75.
+// coefficients (written as published, more digits than an f64 holds, so
+// that they can be checked against the source); on 0 ≤ s ≤ 1/2 its error is
+// below 2^-58.75.
+#[allow(clippy::excessive_precision)]
 const P_S0: f64 = 1.666_666_666_666_666_574_15e-1;
+#[allow(clippy::excessive_precision)]
 const P_S1: f64 = -3.255_658_186_224_009_154_05e-1;
+#[allow(clippy::excessive_precision)]
 const P_S2: f64 = 2.012_125_321_348_629_258_81e-1;
+#[allow(clippy::excessive_precision)]
 const P_S3: f64 = -4.005_553_450_067_941_140_27e-2;
+#[allow(clippy::excessive_precision)]
 const P_S4: f64 = 7.915_349_942_898_145_321_76e-4;
+#[allow(clippy::excessive_precision)]
 const P_S5: f64 = 3.479_331_075_960_211_675_70e-5;
+#[allow(clippy::excessive_precision)]
 const Q_S1: f64 = -2.403_394_911_734_414_218_78;
+#[allow(clippy::excessive_precision)]
 const Q_S2: f64 = 2.020_945_760_233_505_694_71;
+#[allow(clippy::excessive_precision)]
 const Q_S3: f64 = -6.882_839_716_054_532_930_30e-1;
+#[allow(clippy::excessive_precision)]
 const Q_S4: f64 = 7.703_815_055_590_193_527_91e-2;
 
 /// `acos(x).to_degrees()` for each lane, `x` clamped to `[-1, 1]`, within
@@ -325,7 +338,10 @@ impl BinThresholds {
         while b + 1 < n && c <= self.tau[b + 1] {
             b += 1;
         }
-        while b > 0 && !(c <= self.tau[b]) {
+        // Not `c > tau`: a NaN cosine must end in bin 0, as its NaN angle does.
+        let at_most =
+            |tau: f64| matches!(c.partial_cmp(&tau), Some(Ordering::Less | Ordering::Equal));
+        while b > 0 && !at_most(self.tau[b]) {
             b -= 1;
         }
         b
