@@ -402,7 +402,7 @@ impl TetMesh {
                         .map(move |e| edge_key(v[e[0]], v[e[1]]))
                 })
                 .collect();
-            let mut tagged = HashMap::new();
+            let mut tagged = crate::mesh::fasthash::FastHashMap::default();
             for &([a, b], m) in &data.edges {
                 let k = edge_key(a, b);
                 if edges.contains(&k) {

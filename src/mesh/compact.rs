@@ -1,7 +1,7 @@
 //! [`TetMesh::compact`]: the one place where ids move.
 
+use super::fasthash::{FastHashMap, FastHashSet};
 use super::{TetMesh, DEAD, NO_ADJ};
-use std::collections::{HashMap, HashSet};
 
 /// Where ids went in a [`TetMesh::compact`]: `old → new`, [`DEAD`] for removed.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
@@ -87,25 +87,25 @@ impl TetMesh {
             .drain()
             .filter(|(k, _)| k.iter().all(|&v| pm(v) != DEAD))
             .map(|(k, m)| (super::face_key(k.map(pm)), m))
-            .collect::<HashMap<_, _>>();
+            .collect::<FastHashMap<_, _>>();
         self.feature_edges = self
             .feature_edges
             .drain()
             .filter(|(k, _)| k.iter().all(|&v| pm(v) != DEAD))
             .map(|(k, m)| (super::edge_key(pm(k[0]), pm(k[1])), m))
-            .collect::<HashMap<_, _>>();
+            .collect::<FastHashMap<_, _>>();
         self.corners = self
             .corners
             .iter()
             .map(|&v| pm(v))
             .filter(|&v| v != DEAD)
-            .collect::<HashSet<_>>();
+            .collect::<FastHashSet<_>>();
         self.required = self
             .required
             .iter()
             .map(|&v| pm(v))
             .filter(|&v| v != DEAD)
-            .collect::<HashSet<_>>();
+            .collect::<FastHashSet<_>>();
         Remap {
             points: point_map,
             tets: tet_map,

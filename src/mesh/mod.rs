@@ -28,9 +28,9 @@ pub use compact::Remap;
 pub use data::MeshData;
 
 use crate::geom::{TET_EDGES, TET_EDGE_OPPOSITE, TET_FACES};
+use fasthash::{FastHashMap, FastHashSet};
 use glam::DVec3;
 use rayon::prelude::*;
-use std::collections::{HashMap, HashSet};
 
 /// Adjacency value of a boundary face.
 pub const NO_ADJ: u32 = u32::MAX;
@@ -112,10 +112,11 @@ pub struct TetMesh {
     pub(crate) region: Vec<i32>,
     pub(crate) level: Vec<u8>,
     pub(crate) parent: Vec<u32>,
-    pub(crate) face_markers: HashMap<FaceKey, i32>,
-    pub(crate) feature_edges: HashMap<EdgeKey, i32>,
-    pub(crate) corners: HashSet<u32>,
-    pub(crate) required: HashSet<u32>,
+    // Fast hashing: the hot loops of every phase look edges and faces up here.
+    pub(crate) face_markers: FastHashMap<FaceKey, i32>,
+    pub(crate) feature_edges: FastHashMap<EdgeKey, i32>,
+    pub(crate) corners: FastHashSet<u32>,
+    pub(crate) required: FastHashSet<u32>,
     /// One live tet holding each vertex (`DEAD` for unused points). Every
     /// operation re-creates tets over all vertices of the cavity it removes, and
     /// `alloc_tet`/`set_tet` write this entry, so it never goes stale.
@@ -303,7 +304,7 @@ impl TetMesh {
     }
 
     /// All marked faces (sorted vertex keys) and their markers.
-    pub fn face_markers(&self) -> &HashMap<FaceKey, i32> {
+    pub fn face_markers(&self) -> &FastHashMap<FaceKey, i32> {
         &self.face_markers
     }
 
@@ -330,7 +331,7 @@ impl TetMesh {
     }
 
     /// All feature edges and their markers.
-    pub fn feature_edges(&self) -> &HashMap<EdgeKey, i32> {
+    pub fn feature_edges(&self) -> &FastHashMap<EdgeKey, i32> {
         &self.feature_edges
     }
 
@@ -355,7 +356,7 @@ impl TetMesh {
     }
 
     /// Corner vertices.
-    pub fn corners(&self) -> &HashSet<u32> {
+    pub fn corners(&self) -> &FastHashSet<u32> {
         &self.corners
     }
 
@@ -374,7 +375,7 @@ impl TetMesh {
     }
 
     /// Required vertices.
-    pub fn required_vertices(&self) -> &HashSet<u32> {
+    pub fn required_vertices(&self) -> &FastHashSet<u32> {
         &self.required
     }
 

@@ -6,9 +6,9 @@
 //! cache misses of ball walks). The order is a pure function of the mesh, so
 //! it is deterministic for any number of threads.
 
+use super::fasthash::{FastHashMap, FastHashSet};
 use super::{edge_key, face_key, Remap, TetMesh, DEAD, NO_ADJ};
 use rayon::prelude::*;
-use std::collections::{HashMap, HashSet};
 
 /// Spreads the low 21 bits of `x` to every third bit.
 fn spread(x: u64) -> u64 {
@@ -124,14 +124,22 @@ impl TetMesh {
             .face_markers
             .drain()
             .map(|(k, m)| (face_key(k.map(pm)), m))
-            .collect::<HashMap<_, _>>();
+            .collect::<FastHashMap<_, _>>();
         self.feature_edges = self
             .feature_edges
             .drain()
             .map(|(k, m)| (edge_key(pm(k[0]), pm(k[1])), m))
-            .collect::<HashMap<_, _>>();
-        self.corners = self.corners.iter().map(|&v| pm(v)).collect::<HashSet<_>>();
-        self.required = self.required.iter().map(|&v| pm(v)).collect::<HashSet<_>>();
+            .collect::<FastHashMap<_, _>>();
+        self.corners = self
+            .corners
+            .iter()
+            .map(|&v| pm(v))
+            .collect::<FastHashSet<_>>();
+        self.required = self
+            .required
+            .iter()
+            .map(|&v| pm(v))
+            .collect::<FastHashSet<_>>();
         self.rebuild_v2t();
 
         let compose = |a: &[u32], b: &[u32]| -> Vec<u32> {

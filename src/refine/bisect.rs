@@ -35,7 +35,6 @@ use crate::geom::{orient3d_sign, Orientation, TET_EDGES};
 use crate::mesh::{edge_key, face_key, EdgeKey, FaceKey, TetMesh, DEAD, NO_ADJ};
 use glam::DVec3;
 use rayon::prelude::*;
-use std::collections::HashMap;
 use std::sync::OnceLock;
 
 /// Why a bisection step could not be done.
@@ -505,7 +504,8 @@ fn bisect_dense(m: &TetMesh) -> Result<TetMesh, BisectError> {
             ])
         })
         .collect();
-    let face_markers: HashMap<FaceKey, i32> = face_children?.into_iter().flatten().collect();
+    let face_markers: crate::mesh::fasthash::FastHashMap<FaceKey, i32> =
+        face_children?.into_iter().flatten().collect();
 
     let edges: Vec<(EdgeKey, i32)> = m.feature_edges.iter().map(|(k, &v)| (*k, v)).collect();
     let edge_children: Result<Vec<[(EdgeKey, i32); 2]>, BisectError> = edges
@@ -519,7 +519,8 @@ fn bisect_dense(m: &TetMesh) -> Result<TetMesh, BisectError> {
             Ok([(edge_key(a, mid), marker), (edge_key(mid, b), marker)])
         })
         .collect();
-    let feature_edges: HashMap<EdgeKey, i32> = edge_children?.into_iter().flatten().collect();
+    let feature_edges: crate::mesh::fasthash::FastHashMap<EdgeKey, i32> =
+        edge_children?.into_iter().flatten().collect();
 
     Ok(TetMesh {
         points: all_points,
