@@ -10,10 +10,10 @@
 //! and its tags are untouched.
 
 use super::colour::{colour_balls_except, Balls};
-use super::laplacian::{laplacian_position, BallNow};
-use super::optimize::{optimize_position, OptimizeParams};
+use super::laplacian::{laplacian_position_in, BallNow};
+use super::optimize::{optimize_position_in, OptimizeParams};
 use super::ring::{canonicalize_ring, improving_ring_triangulation, RingScratch};
-use super::tet_points_with;
+use super::BallPoints;
 use crate::geom::{tet_min_sine, TET_EDGES};
 use crate::mesh::fasthash::{FastHashMap, FastHashSet};
 use crate::mesh::{edge_key, EdgeKey, TetMesh, NO_ADJ};
@@ -21,6 +21,7 @@ use crate::ops::edge_removal::{apply_ring_triangulation, RingTriangulation};
 use crate::ops::EdgeRing;
 use glam::DVec3;
 use rayon::prelude::*;
+macro_rules! prof { ($($a:tt)*) => { if std::env::var_os("TPROF").is_some() { eprintln!($($a)*); } } }
 use std::sync::atomic::{AtomicU8, Ordering};
 
 /// Options of [`improve`].
@@ -171,6 +172,7 @@ const EDGE_OF: [[u8; 4]; 4] = [[6, 0, 1, 2], [0, 6, 3, 4], [1, 3, 6, 5], [2, 4, 
 /// parallel (see [`super::colour`]). The result does not depend on the
 /// number of threads.
 pub fn improve(mesh: &mut TetMesh, opts: &ImproveOptions) -> ImproveReport {
+    let t00 = std::time::Instant::now();
     let fixed = fixed_vertices(mesh);
     let movable: Vec<bool> = (0..mesh.n_points())
         .map(|v| {
@@ -184,12 +186,16 @@ pub fn improve(mesh: &mut TetMesh, opts: &ImproveOptions) -> ImproveReport {
     drop(fixed);
     let mut report = ImproveReport::default();
     let mut tr = Tracker::new(mesh, opts.tet_allowed.clone());
+    prof!("setup {:.3}s", t00.elapsed().as_secs_f64());
     let mut edges = EdgeRemoval::default();
     let mut masks = Vec::new();
     for _ in 0..opts.passes {
         report.passes += 1;
+        let t0 = std::time::Instant::now();
         let mut changed = edges.pass(mesh, &mut tr, opts, &mut report);
+        let t1 = std::time::Instant::now();
         changed += smooth_pass(mesh, &mut tr, &movable, opts, &mut masks, &mut report);
+        prof!("pass {} edges {:.3}s smooth {:.3}s report {:?}", report.passes, (t1-t0).as_secs_f64(), t1.elapsed().as_secs_f64(), report);
         if changed == 0 {
             break;
         }
@@ -241,6 +247,7 @@ impl EdgeRemoval {
         opts: &ImproveOptions,
         report: &mut ImproveReport,
     ) -> usize {
+        let t0 = std::time::Instant::now();
         let candidates: Vec<u32> = (0..mesh.n_tet_slots() as u32)
             .into_par_iter()
             .with_min_len(4096)
@@ -274,6 +281,8 @@ impl EdgeRemoval {
                 .flatten_iter()
                 .collect()
         };
+        prof!("  edge search: {} candidates, {} found, {:.3}s", candidates.len(), found.len(), t0.elapsed().as_secs_f64());
+        let t0 = std::time::Instant::now();
         // The records by edge; two threads may have found the same edge at
         // once (same record). `has_found` flags the tets of their rings.
         self.has_found.clear();
@@ -334,6 +343,7 @@ impl EdgeRemoval {
             }
         }
         report.edges_removed += removed;
+        prof!("  edge apply: {} removed, {} retried {:.3}s", removed, retried.len(), t0.elapsed().as_secs_f64());
         removed
     }
 }
@@ -408,6 +418,8 @@ fn search_tet(
 struct SmoothScratch {
     neighbours: Vec<u32>,
     qualities: Vec<f64>,
+    trial: Vec<f64>,
+    ball: BallPoints,
 }
 
 /// A vertex move decided by [`smooth_vertex`].
@@ -453,16 +465,29 @@ fn smooth_vertex(
         mean,
         first: worst,
     };
-    if let Some((x2, q2)) =
-        laplacian_position(mesh, v, ball, now, &mut s.neighbours, &mut s.qualities)
-    {
+    s.ball.load(mesh, v, ball);
+    if let Some((x2, q2)) = laplacian_position_in(
+        mesh,
+        v,
+        ball,
+        &s.ball,
+        now,
+        &mut s.neighbours,
+        &mut s.qualities,
+    ) {
         x = x2;
         q = q2;
         laplacian = true;
     }
     let mut optimized = false;
     if q < opts.threshold {
-        if let Some((x3, _)) = optimize_position(mesh, v, x, ball, &OptimizeParams::default()) {
+        if let Some((x3, _)) = optimize_position_in(
+            &s.ball,
+            x,
+            &OptimizeParams::default(),
+            &mut s.qualities,
+            &mut s.trial,
+        ) {
             x = x3;
             optimized = true;
         }
@@ -470,13 +495,9 @@ fn smooth_vertex(
     if !(laplacian || optimized) {
         return None;
     }
-    let qualities = if optimized {
-        ball.iter()
-            .map(|&t| tet_min_sine(&tet_points_with(mesh, t, v, x)))
-            .collect()
-    } else {
-        s.qualities.clone()
-    };
+    // After a Laplacian move or a successful optimization, `s.qualities`
+    // holds the ball's qualities at `x`.
+    let qualities = s.qualities.clone();
     Some(VertexMove {
         x,
         laplacian,
@@ -495,6 +516,7 @@ fn smooth_pass(
     masks: &mut Vec<u64>,
     report: &mut ImproveReport,
 ) -> usize {
+    let t0 = std::time::Instant::now();
     let mut vq = vec![f64::INFINITY; mesh.n_points()];
     for (t, tv) in mesh.tet_slots().iter().enumerate() {
         let q = tr.tq[t];
@@ -516,48 +538,131 @@ fn smooth_pass(
             verts.push(v as u32);
         }
     }
+    prof!("  vq+verts {:.3}s: {} verts", t0.elapsed().as_secs_f64(), verts.len());
+    let t0 = std::time::Instant::now();
     let balls = Balls::gather(mesh, &verts);
+    prof!("  balls {:.3}s", t0.elapsed().as_secs_f64());
+    let t0 = std::time::Instant::now();
     // The vertices bad enough for optimization-based smoothing are few, and
     // the worst tets hinge on them: they are smoothed one by one in vertex
     // order before and after the colour classes (smoothing them only in
     // colour order lost up to 4.5° of the tripod's worst angle).
     let classes = colour_balls_except(&balls, masks, |i| vq[verts[i] as usize] < opts.threshold);
     drop(vq);
+    prof!("  colour {:.3}s: {} classes, {} alone", t0.elapsed().as_secs_f64(), classes.len(), classes.iter().filter(|c| c.len()==1).count());
+    let t0 = std::time::Instant::now();
+    let mut ta = 0.0;
     let mut moved = 0;
     let mut scratch = SmoothScratch::default();
-    for class in &classes {
-        let moves: Vec<Option<VertexMove>> = {
-            let mesh = &*mesh;
-            let tq = &tr.tq;
-            let one = |s: &mut SmoothScratch, i: u32| {
-                let ball = balls.ball(i as usize);
-                if ball.is_empty() {
-                    return None;
-                }
-                smooth_vertex(mesh, tq, verts[i as usize], ball, opts, s)
-            };
-            if class.len() < 64 {
-                // Not worth a trip through the thread pool.
-                class.iter().map(|&i| one(&mut scratch, i)).collect()
-            } else {
-                class
-                    .par_iter()
-                    .with_min_len(64)
-                    .map_init(SmoothScratch::default, |s, &i| one(s, i))
-                    .collect()
-            }
+    let mut c = 0;
+    while c < classes.len() {
+        let tc = std::time::Instant::now();
+        let single = classes[c].len() == 1;
+        let groups = if single {
+            // A run of one-vertex classes: smoothed one by one, in order, or
+            // exactly as if, by dependency levels.
+            let end = (c..classes.len())
+                .find(|&k| classes[k].len() != 1)
+                .unwrap_or(classes.len());
+            let seq: Vec<u32> = classes[c..end].iter().map(|k| k[0]).collect();
+            c = end;
+            sequential_levels(&balls, &seq, masks)
+        } else {
+            c += 1;
+            vec![classes[c - 1].clone()]
         };
-        for (&i, m) in class.iter().zip(moves) {
-            let Some(m) = m else { continue };
-            let v = verts[i as usize];
-            mesh.set_point(v, m.x);
-            for (&t, &q) in balls.ball(i as usize).iter().zip(&m.qualities) {
-                tr.set(mesh, t, q);
+        for group in &groups {
+            let moves = decide_moves(mesh, &tr.tq, &balls, &verts, group, opts, &mut scratch);
+            for (&i, m) in group.iter().zip(moves) {
+                let Some(m) = m else { continue };
+                apply_move(mesh, tr, balls.ball(i as usize), verts[i as usize], m, report);
+                moved += 1;
             }
-            moved += 1;
-            report.laplacian_moves += m.laplacian as usize;
-            report.optimized_moves += m.optimized as usize;
+        }
+        if single {
+            ta += tc.elapsed().as_secs_f64();
         }
     }
+    prof!("  classes {:.3}s (singletons {:.3}s)", t0.elapsed().as_secs_f64(), ta);
     moved
+}
+
+/// Moves `v` (ball `ball`) as `m` says and records the ball's new qualities.
+fn apply_move(
+    mesh: &mut TetMesh,
+    tr: &mut Tracker,
+    ball: &[u32],
+    v: u32,
+    m: VertexMove,
+    report: &mut ImproveReport,
+) {
+    mesh.set_point(v, m.x);
+    for (&t, &q) in ball.iter().zip(&m.qualities) {
+        tr.set(mesh, t, q);
+    }
+    report.laplacian_moves += m.laplacian as usize;
+    report.optimized_moves += m.optimized as usize;
+}
+
+/// The balls of `seq` grouped so that smoothing the groups one after the
+/// other, each group's vertices in any order or at once, is exactly smoothing
+/// `seq` one by one in order: a vertex's group comes after the groups of all
+/// earlier vertices of `seq` sharing a tet with it (its level in the
+/// dependency order), and vertices of one group share no tet. `levels` is
+/// per-tet-slot scratch, all zero on entry and on return.
+fn sequential_levels(balls: &Balls, seq: &[u32], levels: &mut Vec<u64>) -> Vec<Vec<u32>> {
+    let mut groups: Vec<Vec<u32>> = Vec::new();
+    for &i in seq {
+        let ball = balls.ball(i as usize);
+        if let Some(&top) = ball.iter().max() {
+            if levels.len() <= top as usize {
+                levels.resize(top as usize + 1, 0);
+            }
+        }
+        let l = ball.iter().map(|&t| levels[t as usize]).max().unwrap_or(0) + 1;
+        for &t in ball {
+            levels[t as usize] = l;
+        }
+        if groups.len() < l as usize {
+            groups.resize_with(l as usize, Vec::new);
+        }
+        groups[l as usize - 1].push(i);
+    }
+    for &i in seq {
+        for &t in balls.ball(i as usize) {
+            levels[t as usize] = 0;
+        }
+    }
+    prof!("    seq {} levels {}", seq.len(), groups.len());
+    groups
+}
+
+/// The moves [`smooth_vertex`] decides for the vertices of balls `group`
+/// (no two sharing a tet), in parallel if there are enough of them.
+fn decide_moves(
+    mesh: &TetMesh,
+    tq: &[f64],
+    balls: &Balls,
+    verts: &[u32],
+    group: &[u32],
+    opts: &ImproveOptions,
+    scratch: &mut SmoothScratch,
+) -> Vec<Option<VertexMove>> {
+    let one = |s: &mut SmoothScratch, i: u32| {
+        let ball = balls.ball(i as usize);
+        if ball.is_empty() {
+            return None;
+        }
+        smooth_vertex(mesh, tq, verts[i as usize], ball, opts, s)
+    };
+    if group.len() < 64 {
+        // Not worth a trip through the thread pool.
+        group.iter().map(|&i| one(scratch, i)).collect()
+    } else {
+        group
+            .par_iter()
+            .with_min_len(32)
+            .map_init(SmoothScratch::default, |s, &i| one(s, i))
+            .collect()
+    }
 }
