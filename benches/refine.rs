@@ -30,7 +30,10 @@ fn selected_sizes() -> Vec<(&'static str, usize)> {
         Ok(list) => SIZES
             .iter()
             .copied()
-            .filter(|(label, _)| list.split(',').any(|s| s.trim().eq_ignore_ascii_case(label)))
+            .filter(|(label, _)| {
+                list.split(',')
+                    .any(|s| s.trim().eq_ignore_ascii_case(label))
+            })
             .collect(),
         Err(_) => SIZES.to_vec(),
     }

@@ -55,9 +55,11 @@ fn main() {
                 .expect("the cube grid is valid")
                 .0
         }
-        None => tetrefine::io::load_mesh(Path::new(&arg))
-            .unwrap_or_else(|e| panic!("{e}"))
-            .0,
+        None => {
+            tetrefine::io::load_mesh(Path::new(&arg))
+                .unwrap_or_else(|e| panic!("{e}"))
+                .0
+        }
     };
     for step in 1..=steps {
         let r = refine_step_with_progress(&mut m, step, &RefineOptions::default(), &MemoryLines);

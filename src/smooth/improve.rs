@@ -173,6 +173,12 @@ const EDGE_OF: [[u8; 4]; 4] = [[6, 0, 1, 2], [0, 6, 3, 4], [1, 3, 6, 5], [2, 4, 
 /// number of threads.
 pub fn improve(mesh: &mut TetMesh, opts: &ImproveOptions) -> ImproveReport {
     let t00 = std::time::Instant::now();
+    prof!(
+        "start slots {} cap {} free {}",
+        mesh.n_tet_slots(),
+        mesh.tets.capacity(),
+        mesh.free.len()
+    );
     let fixed = fixed_vertices(mesh);
     let movable: Vec<bool> = (0..mesh.n_points())
         .map(|v| {
@@ -188,25 +194,63 @@ pub fn improve(mesh: &mut TetMesh, opts: &ImproveOptions) -> ImproveReport {
     let mut tr = Tracker::new(mesh, opts.tet_allowed.clone());
     prof!("setup {:.3}s", t00.elapsed().as_secs_f64());
     let mut edges = EdgeRemoval::default();
-    let mut masks = Vec::new();
     for _ in 0..opts.passes {
         report.passes += 1;
         let t0 = std::time::Instant::now();
         let mut changed = edges.pass(mesh, &mut tr, opts, &mut report);
         let t1 = std::time::Instant::now();
-        changed += smooth_pass(mesh, &mut tr, &movable, opts, &mut masks, &mut report);
-        prof!("pass {} edges {:.3}s smooth {:.3}s report {:?}", report.passes, (t1-t0).as_secs_f64(), t1.elapsed().as_secs_f64(), report);
+        changed += smooth_pass(mesh, &mut tr, &movable, opts, &mut report);
+        prof!(
+            "pass {} edges {:.3}s smooth {:.3}s report {:?}",
+            report.passes,
+            (t1 - t0).as_secs_f64(),
+            t1.elapsed().as_secs_f64(),
+            report
+        );
         if changed == 0 {
             break;
         }
     }
+    prof!(
+        "end slots {} cap {} free {}",
+        mesh.n_tet_slots(),
+        mesh.tets.capacity(),
+        mesh.free.len()
+    );
     report
 }
 
-/// A removable edge found by the search half of an edge removal pass.
+/// A removable edge found by the search half of an edge removal pass: the
+/// edge and the triangles of its canonical ring's best triangulation, as
+/// ring positions (the ring itself is gathered again when it is removed, so
+/// that the records stay small).
 struct Removable {
-    ring: EdgeRing,
-    tri: RingTriangulation,
+    key: EdgeKey,
+    triangles: Box<[[u8; 3]]>,
+}
+
+impl Removable {
+    fn new(ring: &EdgeRing, tri: &RingTriangulation) -> Removable {
+        Removable {
+            key: edge_key(ring.a, ring.b),
+            triangles: tri
+                .triangles
+                .iter()
+                .map(|&[i, k, j]| [i as u8, k as u8, j as u8])
+                .collect(),
+        }
+    }
+
+    fn triangulation(&self) -> RingTriangulation {
+        RingTriangulation {
+            quality: f64::NAN,
+            triangles: self
+                .triangles
+                .iter()
+                .map(|&[i, k, j]| [i as usize, k as usize, j as usize])
+                .collect(),
+        }
+    }
 }
 
 /// Buffers of the edge removal passes.
@@ -265,23 +309,35 @@ impl EdgeRemoval {
         self.tried.clear();
         self.tried
             .resize_with(mesh.n_tet_slots(), || AtomicU8::new(0));
-        let found: Vec<Removable> = {
+        let (found, found_tets): (Vec<Removable>, Vec<u32>) = {
             let mesh = &*mesh;
             let tr = &*tr;
             let tried = &self.tried;
-            candidates
+            let parts: Vec<(Vec<Removable>, Vec<u32>)> = candidates
                 .par_chunks(256)
                 .map_init(EdgeScratch::default, |s, chunk| {
                     let mut found = Vec::new();
+                    let mut tets = Vec::new();
                     for &t in chunk {
-                        search_tet(mesh, tr, tried, opts, t, s, &mut found);
+                        search_tet(mesh, tr, tried, opts, t, s, &mut found, &mut tets);
                     }
-                    found
+                    (found, tets)
                 })
-                .flatten_iter()
-                .collect()
+                .collect();
+            let mut found = Vec::new();
+            let mut tets = Vec::new();
+            for (f, t) in parts {
+                found.extend(f);
+                tets.extend(t);
+            }
+            (found, tets)
         };
-        prof!("  edge search: {} candidates, {} found, {:.3}s", candidates.len(), found.len(), t0.elapsed().as_secs_f64());
+        prof!(
+            "  edge search: {} candidates, {} found, {:.3}s",
+            candidates.len(),
+            found.len(),
+            t0.elapsed().as_secs_f64()
+        );
         let t0 = std::time::Instant::now();
         // The records by edge; two threads may have found the same edge at
         // once (same record). `has_found` flags the tets of their rings.
@@ -290,11 +346,12 @@ impl EdgeRemoval {
         let mut by_edge: FastHashMap<EdgeKey, Removable> =
             FastHashMap::with_capacity_and_hasher(found.len(), Default::default());
         for f in found {
-            for &u in &f.ring.tets {
-                self.has_found[u as usize] = true;
-            }
-            by_edge.insert(edge_key(f.ring.a, f.ring.b), f);
+            by_edge.insert(f.key, f);
         }
+        for &t in &found_tets {
+            self.has_found[t as usize] = true;
+        }
+        drop(found_tets);
         // Apply, visiting the candidates' edges in order as a sequential pass
         // would. Removing an edge changes only tets whose vertices are all in
         // its cavity, so the ring of an edge with an end outside every cavity
@@ -312,24 +369,37 @@ impl EdgeRemoval {
             let v = mesh.tet(t);
             for (e, &[i, j]) in TET_EDGES.iter().enumerate() {
                 let key = edge_key(v[i], v[j]);
-                let rec = if self.touched[v[i] as usize] && self.touched[v[j] as usize] {
+                let tri = if self.touched[v[i] as usize] && self.touched[v[j] as usize] {
                     if !retried.insert(key) || mesh.is_feature_edge(v[i], v[j]) {
                         continue;
                     }
                     search_edge(mesh, tr, opts, t, e, &mut scratch)
                 } else if (t as usize) < self.has_found.len() && self.has_found[t as usize] {
-                    by_edge.remove(&key)
+                    by_edge.remove(&key).map(|f| {
+                        // The ring is the one the search saw: gather it again.
+                        scratch.ring.gather_into(mesh, t, e);
+                        canonicalize_ring(&mut scratch.ring);
+                        f.triangulation()
+                    })
                 } else {
                     None
                 };
-                let Some(f) = rec else { continue };
-                let Ok(new) = apply_ring_triangulation(mesh, &f.ring, &f.tri) else {
+                let Some(tri) = tri else { continue };
+                let ring = &scratch.ring;
+                // Room for the new tets in small exact steps: a `Vec` doubling
+                // of every per-slot array for a few extra slots would stay
+                // with the mesh.
+                let need = 2 * tri.triangles.len();
+                if mesh.free.len() < need && mesh.tets.capacity() - mesh.tets.len() < need {
+                    mesh.reserve_tets_exact((mesh.n_tet_slots() / 256).max(need));
+                }
+                let Ok(new) = apply_ring_triangulation(mesh, ring, &tri) else {
                     continue;
                 };
                 removed += 1;
                 let slots = mesh.n_tet_slots();
                 tr.grow(slots);
-                for &x in f.ring.verts.iter().chain([&f.ring.a, &f.ring.b]) {
+                for &x in ring.verts.iter().chain([&ring.a, &ring.b]) {
                     self.touched[x as usize] = true;
                 }
                 for n in new {
@@ -343,14 +413,22 @@ impl EdgeRemoval {
             }
         }
         report.edges_removed += removed;
-        prof!("  edge apply: {} removed, {} retried {:.3}s", removed, retried.len(), t0.elapsed().as_secs_f64());
+        // Per-slot and per-point buffers are not kept between passes (the
+        // smoothing half needs the room).
+        *self = EdgeRemoval::default();
+        prof!(
+            "  edge apply: {} removed, {} retried {:.3}s",
+            removed,
+            retried.len(),
+            t0.elapsed().as_secs_f64()
+        );
         removed
     }
 }
 
 /// Gathers the ring of local edge `e` of `t` into `s.ring` and, if it is a
 /// closed ring of allowed tets that can be re-triangulated with a better worst
-/// tet, returns it in canonical form with its triangulation.
+/// tet, leaves it there in canonical form and returns its triangulation.
 fn search_edge(
     mesh: &TetMesh,
     tr: &Tracker,
@@ -358,11 +436,11 @@ fn search_edge(
     t: u32,
     e: usize,
     s: &mut EdgeScratch,
-) -> Option<Removable> {
+) -> Option<RingTriangulation> {
     let ring = &mut s.ring;
     ring.gather_into(mesh, t, e);
     if !ring.closed
-        || ring.tets.len() > opts.max_ring
+        || ring.tets.len() > opts.max_ring.min(255) // ring positions are kept as u8
         || !ring.tets.iter().all(|&u| tr.is_allowed(u))
     {
         return None;
@@ -373,15 +451,13 @@ fn search_edge(
         .map(|&u| tr.tq[u as usize])
         .fold(f64::INFINITY, f64::min);
     canonicalize_ring(ring);
-    let tri = improving_ring_triangulation(mesh, ring, worst + 1e-12, &mut s.dp)?;
-    Some(Removable {
-        ring: ring.clone(),
-        tri,
-    })
+    improving_ring_triangulation(mesh, ring, worst + 1e-12, &mut s.dp)
 }
 
 /// The search half of [`EdgeRemoval::pass`] for the edges of candidate tet
-/// `t` not tried yet: appends the removable ones to `found`.
+/// `t` not tried yet: appends the removable ones to `found` and their rings'
+/// tets to `found_tets`.
+#[allow(clippy::too_many_arguments)]
 fn search_tet(
     mesh: &TetMesh,
     tr: &Tracker,
@@ -390,6 +466,7 @@ fn search_tet(
     t: u32,
     s: &mut EdgeScratch,
     found: &mut Vec<Removable>,
+    found_tets: &mut Vec<u32>,
 ) {
     let v = mesh.tet(t);
     for (e, &[i, j]) in TET_EDGES.iter().enumerate() {
@@ -409,7 +486,10 @@ fn search_tet(
                 tried[u as usize].fetch_or(1 << k, Ordering::Relaxed);
             }
         }
-        found.extend(rec);
+        if let Some(tri) = rec {
+            found.push(Removable::new(&s.ring, &tri));
+            found_tets.extend_from_slice(&s.ring.tets);
+        }
     }
 }
 
@@ -513,7 +593,6 @@ fn smooth_pass(
     tr: &mut Tracker,
     movable: &[bool],
     opts: &ImproveOptions,
-    masks: &mut Vec<u64>,
     report: &mut ImproveReport,
 ) -> usize {
     let t0 = std::time::Instant::now();
@@ -538,7 +617,11 @@ fn smooth_pass(
             verts.push(v as u32);
         }
     }
-    prof!("  vq+verts {:.3}s: {} verts", t0.elapsed().as_secs_f64(), verts.len());
+    prof!(
+        "  vq+verts {:.3}s: {} verts",
+        t0.elapsed().as_secs_f64(),
+        verts.len()
+    );
     let t0 = std::time::Instant::now();
     let balls = Balls::gather(mesh, &verts);
     prof!("  balls {:.3}s", t0.elapsed().as_secs_f64());
@@ -547,43 +630,57 @@ fn smooth_pass(
     // the worst tets hinge on them: they are smoothed one by one in vertex
     // order before and after the colour classes (smoothing them only in
     // colour order lost up to 4.5° of the tripod's worst angle).
-    let classes = colour_balls_except(&balls, masks, |i| vq[verts[i] as usize] < opts.threshold);
+    // Per-slot scratch of the colouring and of the levels, dropped before
+    // the smoothing.
+    let mut masks = Vec::new();
+    let mut classes = colour_balls_except(&balls, &mut masks, |i| {
+        vq[verts[i] as usize] < opts.threshold
+    });
     drop(vq);
-    prof!("  colour {:.3}s: {} classes, {} alone", t0.elapsed().as_secs_f64(), classes.len(), classes.iter().filter(|c| c.len()==1).count());
+    prof!(
+        "  colour {:.3}s: {} classes, {} alone",
+        t0.elapsed().as_secs_f64(),
+        classes.len(),
+        classes.iter().filter(|c| c.len() == 1).count()
+    );
     let t0 = std::time::Instant::now();
-    let mut ta = 0.0;
     let mut moved = 0;
     let mut scratch = SmoothScratch::default();
+    // Runs of one-vertex classes are smoothed one by one, in order, or
+    // exactly as if, by dependency levels.
+    let mut groups: Vec<Vec<u32>> = Vec::new();
     let mut c = 0;
     while c < classes.len() {
-        let tc = std::time::Instant::now();
-        let single = classes[c].len() == 1;
-        let groups = if single {
-            // A run of one-vertex classes: smoothed one by one, in order, or
-            // exactly as if, by dependency levels.
+        if classes[c].len() == 1 {
             let end = (c..classes.len())
                 .find(|&k| classes[k].len() != 1)
                 .unwrap_or(classes.len());
             let seq: Vec<u32> = classes[c..end].iter().map(|k| k[0]).collect();
             c = end;
-            sequential_levels(&balls, &seq, masks)
+            groups.extend(sequential_levels(&balls, &seq, &mut masks));
         } else {
+            groups.push(std::mem::take(&mut classes[c]));
             c += 1;
-            vec![classes[c - 1].clone()]
-        };
-        for group in &groups {
-            let moves = decide_moves(mesh, &tr.tq, &balls, &verts, group, opts, &mut scratch);
-            for (&i, m) in group.iter().zip(moves) {
-                let Some(m) = m else { continue };
-                apply_move(mesh, tr, balls.ball(i as usize), verts[i as usize], m, report);
-                moved += 1;
-            }
-        }
-        if single {
-            ta += tc.elapsed().as_secs_f64();
         }
     }
-    prof!("  classes {:.3}s (singletons {:.3}s)", t0.elapsed().as_secs_f64(), ta);
+    drop(masks);
+    drop(classes);
+    for group in &groups {
+        let moves = decide_moves(mesh, &tr.tq, &balls, &verts, group, opts, &mut scratch);
+        for (&i, m) in group.iter().zip(moves) {
+            let Some(m) = m else { continue };
+            apply_move(
+                mesh,
+                tr,
+                balls.ball(i as usize),
+                verts[i as usize],
+                m,
+                report,
+            );
+            moved += 1;
+        }
+    }
+    prof!("  classes {:.3}s", t0.elapsed().as_secs_f64());
     moved
 }
 
