@@ -21,7 +21,6 @@ use crate::ops::edge_removal::{apply_ring_triangulation, RingTriangulation};
 use crate::ops::EdgeRing;
 use glam::DVec3;
 use rayon::prelude::*;
-macro_rules! prof { ($($a:tt)*) => { if std::env::var_os("TPROF").is_some() { eprintln!($($a)*); } } }
 use std::sync::atomic::{AtomicU8, Ordering};
 
 /// Options of [`improve`].
@@ -172,13 +171,6 @@ const EDGE_OF: [[u8; 4]; 4] = [[6, 0, 1, 2], [0, 6, 3, 4], [1, 3, 6, 5], [2, 4, 
 /// parallel (see [`super::colour`]). The result does not depend on the
 /// number of threads.
 pub fn improve(mesh: &mut TetMesh, opts: &ImproveOptions) -> ImproveReport {
-    let t00 = std::time::Instant::now();
-    prof!(
-        "start slots {} cap {} free {}",
-        mesh.n_tet_slots(),
-        mesh.tets.capacity(),
-        mesh.free.len()
-    );
     let fixed = fixed_vertices(mesh);
     let movable: Vec<bool> = (0..mesh.n_points())
         .map(|v| {
@@ -192,31 +184,15 @@ pub fn improve(mesh: &mut TetMesh, opts: &ImproveOptions) -> ImproveReport {
     drop(fixed);
     let mut report = ImproveReport::default();
     let mut tr = Tracker::new(mesh, opts.tet_allowed.clone());
-    prof!("setup {:.3}s", t00.elapsed().as_secs_f64());
     let mut edges = EdgeRemoval::default();
     for _ in 0..opts.passes {
         report.passes += 1;
-        let t0 = std::time::Instant::now();
         let mut changed = edges.pass(mesh, &mut tr, opts, &mut report);
-        let t1 = std::time::Instant::now();
         changed += smooth_pass(mesh, &mut tr, &movable, opts, &mut report);
-        prof!(
-            "pass {} edges {:.3}s smooth {:.3}s report {:?}",
-            report.passes,
-            (t1 - t0).as_secs_f64(),
-            t1.elapsed().as_secs_f64(),
-            report
-        );
         if changed == 0 {
             break;
         }
     }
-    prof!(
-        "end slots {} cap {} free {}",
-        mesh.n_tet_slots(),
-        mesh.tets.capacity(),
-        mesh.free.len()
-    );
     report
 }
 
@@ -291,7 +267,6 @@ impl EdgeRemoval {
         opts: &ImproveOptions,
         report: &mut ImproveReport,
     ) -> usize {
-        let t0 = std::time::Instant::now();
         let candidates: Vec<u32> = (0..mesh.n_tet_slots() as u32)
             .into_par_iter()
             .with_min_len(4096)
@@ -332,13 +307,6 @@ impl EdgeRemoval {
             }
             (found, tets)
         };
-        prof!(
-            "  edge search: {} candidates, {} found, {:.3}s",
-            candidates.len(),
-            found.len(),
-            t0.elapsed().as_secs_f64()
-        );
-        let t0 = std::time::Instant::now();
         // The records by edge; two threads may have found the same edge at
         // once (same record). `has_found` flags the tets of their rings.
         self.has_found.clear();
@@ -416,12 +384,6 @@ impl EdgeRemoval {
         // Per-slot and per-point buffers are not kept between passes (the
         // smoothing half needs the room).
         *self = EdgeRemoval::default();
-        prof!(
-            "  edge apply: {} removed, {} retried {:.3}s",
-            removed,
-            retried.len(),
-            t0.elapsed().as_secs_f64()
-        );
         removed
     }
 }
@@ -595,7 +557,6 @@ fn smooth_pass(
     opts: &ImproveOptions,
     report: &mut ImproveReport,
 ) -> usize {
-    let t0 = std::time::Instant::now();
     let mut vq = vec![f64::INFINITY; mesh.n_points()];
     for (t, tv) in mesh.tet_slots().iter().enumerate() {
         let q = tr.tq[t];
@@ -617,15 +578,7 @@ fn smooth_pass(
             verts.push(v as u32);
         }
     }
-    prof!(
-        "  vq+verts {:.3}s: {} verts",
-        t0.elapsed().as_secs_f64(),
-        verts.len()
-    );
-    let t0 = std::time::Instant::now();
     let balls = Balls::gather(mesh, &verts);
-    prof!("  balls {:.3}s", t0.elapsed().as_secs_f64());
-    let t0 = std::time::Instant::now();
     // The vertices bad enough for optimization-based smoothing are few, and
     // the worst tets hinge on them: they are smoothed one by one in vertex
     // order before and after the colour classes (smoothing them only in
@@ -637,13 +590,6 @@ fn smooth_pass(
         vq[verts[i] as usize] < opts.threshold
     });
     drop(vq);
-    prof!(
-        "  colour {:.3}s: {} classes, {} alone",
-        t0.elapsed().as_secs_f64(),
-        classes.len(),
-        classes.iter().filter(|c| c.len() == 1).count()
-    );
-    let t0 = std::time::Instant::now();
     let mut moved = 0;
     let mut scratch = SmoothScratch::default();
     // Runs of one-vertex classes are smoothed one by one, in order, or
@@ -680,7 +626,6 @@ fn smooth_pass(
             moved += 1;
         }
     }
-    prof!("  classes {:.3}s", t0.elapsed().as_secs_f64());
     moved
 }
 
@@ -730,7 +675,6 @@ fn sequential_levels(balls: &Balls, seq: &[u32], levels: &mut Vec<u64>) -> Vec<V
             levels[t as usize] = 0;
         }
     }
-    prof!("    seq {} levels {}", seq.len(), groups.len());
     groups
 }
 
