@@ -10,10 +10,10 @@
 //! and its tags are untouched.
 
 use super::colour::{colour_balls_except, Balls};
-use super::laplacian::{laplacian_position, BallNow};
-use super::optimize::{optimize_position, OptimizeParams};
+use super::laplacian::{laplacian_position_in, BallNow};
+use super::optimize::{optimize_position_in, OptimizeParams};
 use super::ring::{canonicalize_ring, improving_ring_triangulation, RingScratch};
-use super::tet_points_with;
+use super::BallPoints;
 use crate::geom::{tet_min_sine, TET_EDGES};
 use crate::mesh::fasthash::{FastHashMap, FastHashSet};
 use crate::mesh::{edge_key, EdgeKey, TetMesh, NO_ADJ};
@@ -185,11 +185,10 @@ pub fn improve(mesh: &mut TetMesh, opts: &ImproveOptions) -> ImproveReport {
     let mut report = ImproveReport::default();
     let mut tr = Tracker::new(mesh, opts.tet_allowed.clone());
     let mut edges = EdgeRemoval::default();
-    let mut masks = Vec::new();
     for _ in 0..opts.passes {
         report.passes += 1;
         let mut changed = edges.pass(mesh, &mut tr, opts, &mut report);
-        changed += smooth_pass(mesh, &mut tr, &movable, opts, &mut masks, &mut report);
+        changed += smooth_pass(mesh, &mut tr, &movable, opts, &mut report);
         if changed == 0 {
             break;
         }
@@ -197,10 +196,37 @@ pub fn improve(mesh: &mut TetMesh, opts: &ImproveOptions) -> ImproveReport {
     report
 }
 
-/// A removable edge found by the search half of an edge removal pass.
+/// A removable edge found by the search half of an edge removal pass: the
+/// edge and the triangles of its canonical ring's best triangulation, as
+/// ring positions (the ring itself is gathered again when it is removed, so
+/// that the records stay small).
 struct Removable {
-    ring: EdgeRing,
-    tri: RingTriangulation,
+    key: EdgeKey,
+    triangles: Box<[[u8; 3]]>,
+}
+
+impl Removable {
+    fn new(ring: &EdgeRing, tri: &RingTriangulation) -> Removable {
+        Removable {
+            key: edge_key(ring.a, ring.b),
+            triangles: tri
+                .triangles
+                .iter()
+                .map(|&[i, k, j]| [i as u8, k as u8, j as u8])
+                .collect(),
+        }
+    }
+
+    fn triangulation(&self) -> RingTriangulation {
+        RingTriangulation {
+            quality: f64::NAN,
+            triangles: self
+                .triangles
+                .iter()
+                .map(|&[i, k, j]| [i as usize, k as usize, j as usize])
+                .collect(),
+        }
+    }
 }
 
 /// Buffers of the edge removal passes.
@@ -258,21 +284,28 @@ impl EdgeRemoval {
         self.tried.clear();
         self.tried
             .resize_with(mesh.n_tet_slots(), || AtomicU8::new(0));
-        let found: Vec<Removable> = {
+        let (found, found_tets): (Vec<Removable>, Vec<u32>) = {
             let mesh = &*mesh;
             let tr = &*tr;
             let tried = &self.tried;
-            candidates
+            let parts: Vec<(Vec<Removable>, Vec<u32>)> = candidates
                 .par_chunks(256)
                 .map_init(EdgeScratch::default, |s, chunk| {
                     let mut found = Vec::new();
+                    let mut tets = Vec::new();
                     for &t in chunk {
-                        search_tet(mesh, tr, tried, opts, t, s, &mut found);
+                        search_tet(mesh, tr, tried, opts, t, s, &mut found, &mut tets);
                     }
-                    found
+                    (found, tets)
                 })
-                .flatten_iter()
-                .collect()
+                .collect();
+            let mut found = Vec::new();
+            let mut tets = Vec::new();
+            for (f, t) in parts {
+                found.extend(f);
+                tets.extend(t);
+            }
+            (found, tets)
         };
         // The records by edge; two threads may have found the same edge at
         // once (same record). `has_found` flags the tets of their rings.
@@ -281,11 +314,12 @@ impl EdgeRemoval {
         let mut by_edge: FastHashMap<EdgeKey, Removable> =
             FastHashMap::with_capacity_and_hasher(found.len(), Default::default());
         for f in found {
-            for &u in &f.ring.tets {
-                self.has_found[u as usize] = true;
-            }
-            by_edge.insert(edge_key(f.ring.a, f.ring.b), f);
+            by_edge.insert(f.key, f);
         }
+        for &t in &found_tets {
+            self.has_found[t as usize] = true;
+        }
+        drop(found_tets);
         // Apply, visiting the candidates' edges in order as a sequential pass
         // would. Removing an edge changes only tets whose vertices are all in
         // its cavity, so the ring of an edge with an end outside every cavity
@@ -303,24 +337,37 @@ impl EdgeRemoval {
             let v = mesh.tet(t);
             for (e, &[i, j]) in TET_EDGES.iter().enumerate() {
                 let key = edge_key(v[i], v[j]);
-                let rec = if self.touched[v[i] as usize] && self.touched[v[j] as usize] {
+                let tri = if self.touched[v[i] as usize] && self.touched[v[j] as usize] {
                     if !retried.insert(key) || mesh.is_feature_edge(v[i], v[j]) {
                         continue;
                     }
                     search_edge(mesh, tr, opts, t, e, &mut scratch)
                 } else if (t as usize) < self.has_found.len() && self.has_found[t as usize] {
-                    by_edge.remove(&key)
+                    by_edge.remove(&key).map(|f| {
+                        // The ring is the one the search saw: gather it again.
+                        scratch.ring.gather_into(mesh, t, e);
+                        canonicalize_ring(&mut scratch.ring);
+                        f.triangulation()
+                    })
                 } else {
                     None
                 };
-                let Some(f) = rec else { continue };
-                let Ok(new) = apply_ring_triangulation(mesh, &f.ring, &f.tri) else {
+                let Some(tri) = tri else { continue };
+                let ring = &scratch.ring;
+                // Room for the new tets in small exact steps: a `Vec` doubling
+                // of every per-slot array for a few extra slots would stay
+                // with the mesh.
+                let need = 2 * tri.triangles.len();
+                if mesh.free.len() < need && mesh.tets.capacity() - mesh.tets.len() < need {
+                    mesh.reserve_tets_exact((mesh.n_tet_slots() / 256).max(need));
+                }
+                let Ok(new) = apply_ring_triangulation(mesh, ring, &tri) else {
                     continue;
                 };
                 removed += 1;
                 let slots = mesh.n_tet_slots();
                 tr.grow(slots);
-                for &x in f.ring.verts.iter().chain([&f.ring.a, &f.ring.b]) {
+                for &x in ring.verts.iter().chain([&ring.a, &ring.b]) {
                     self.touched[x as usize] = true;
                 }
                 for n in new {
@@ -334,13 +381,16 @@ impl EdgeRemoval {
             }
         }
         report.edges_removed += removed;
+        // Per-slot and per-point buffers are not kept between passes (the
+        // smoothing half needs the room).
+        *self = EdgeRemoval::default();
         removed
     }
 }
 
 /// Gathers the ring of local edge `e` of `t` into `s.ring` and, if it is a
 /// closed ring of allowed tets that can be re-triangulated with a better worst
-/// tet, returns it in canonical form with its triangulation.
+/// tet, leaves it there in canonical form and returns its triangulation.
 fn search_edge(
     mesh: &TetMesh,
     tr: &Tracker,
@@ -348,11 +398,11 @@ fn search_edge(
     t: u32,
     e: usize,
     s: &mut EdgeScratch,
-) -> Option<Removable> {
+) -> Option<RingTriangulation> {
     let ring = &mut s.ring;
     ring.gather_into(mesh, t, e);
     if !ring.closed
-        || ring.tets.len() > opts.max_ring
+        || ring.tets.len() > opts.max_ring.min(255) // ring positions are kept as u8
         || !ring.tets.iter().all(|&u| tr.is_allowed(u))
     {
         return None;
@@ -363,15 +413,13 @@ fn search_edge(
         .map(|&u| tr.tq[u as usize])
         .fold(f64::INFINITY, f64::min);
     canonicalize_ring(ring);
-    let tri = improving_ring_triangulation(mesh, ring, worst + 1e-12, &mut s.dp)?;
-    Some(Removable {
-        ring: ring.clone(),
-        tri,
-    })
+    improving_ring_triangulation(mesh, ring, worst + 1e-12, &mut s.dp)
 }
 
 /// The search half of [`EdgeRemoval::pass`] for the edges of candidate tet
-/// `t` not tried yet: appends the removable ones to `found`.
+/// `t` not tried yet: appends the removable ones to `found` and their rings'
+/// tets to `found_tets`.
+#[allow(clippy::too_many_arguments)]
 fn search_tet(
     mesh: &TetMesh,
     tr: &Tracker,
@@ -380,6 +428,7 @@ fn search_tet(
     t: u32,
     s: &mut EdgeScratch,
     found: &mut Vec<Removable>,
+    found_tets: &mut Vec<u32>,
 ) {
     let v = mesh.tet(t);
     for (e, &[i, j]) in TET_EDGES.iter().enumerate() {
@@ -399,7 +448,10 @@ fn search_tet(
                 tried[u as usize].fetch_or(1 << k, Ordering::Relaxed);
             }
         }
-        found.extend(rec);
+        if let Some(tri) = rec {
+            found.push(Removable::new(&s.ring, &tri));
+            found_tets.extend_from_slice(&s.ring.tets);
+        }
     }
 }
 
@@ -408,6 +460,8 @@ fn search_tet(
 struct SmoothScratch {
     neighbours: Vec<u32>,
     qualities: Vec<f64>,
+    trial: Vec<f64>,
+    ball: BallPoints,
 }
 
 /// A vertex move decided by [`smooth_vertex`].
@@ -453,16 +507,29 @@ fn smooth_vertex(
         mean,
         first: worst,
     };
-    if let Some((x2, q2)) =
-        laplacian_position(mesh, v, ball, now, &mut s.neighbours, &mut s.qualities)
-    {
+    s.ball.load(mesh, v, ball);
+    if let Some((x2, q2)) = laplacian_position_in(
+        mesh,
+        v,
+        ball,
+        &s.ball,
+        now,
+        &mut s.neighbours,
+        &mut s.qualities,
+    ) {
         x = x2;
         q = q2;
         laplacian = true;
     }
     let mut optimized = false;
     if q < opts.threshold {
-        if let Some((x3, _)) = optimize_position(mesh, v, x, ball, &OptimizeParams::default()) {
+        if let Some((x3, _)) = optimize_position_in(
+            &s.ball,
+            x,
+            &OptimizeParams::default(),
+            &mut s.qualities,
+            &mut s.trial,
+        ) {
             x = x3;
             optimized = true;
         }
@@ -470,13 +537,9 @@ fn smooth_vertex(
     if !(laplacian || optimized) {
         return None;
     }
-    let qualities = if optimized {
-        ball.iter()
-            .map(|&t| tet_min_sine(&tet_points_with(mesh, t, v, x)))
-            .collect()
-    } else {
-        s.qualities.clone()
-    };
+    // After a Laplacian move or a successful optimization, `s.qualities`
+    // holds the ball's qualities at `x`.
+    let qualities = s.qualities.clone();
     Some(VertexMove {
         x,
         laplacian,
@@ -492,7 +555,6 @@ fn smooth_pass(
     tr: &mut Tracker,
     movable: &[bool],
     opts: &ImproveOptions,
-    masks: &mut Vec<u64>,
     report: &mut ImproveReport,
 ) -> usize {
     let mut vq = vec![f64::INFINITY; mesh.n_points()];
@@ -521,43 +583,127 @@ fn smooth_pass(
     // the worst tets hinge on them: they are smoothed one by one in vertex
     // order before and after the colour classes (smoothing them only in
     // colour order lost up to 4.5° of the tripod's worst angle).
-    let classes = colour_balls_except(&balls, masks, |i| vq[verts[i] as usize] < opts.threshold);
+    // Per-slot scratch of the colouring and of the levels, dropped before
+    // the smoothing.
+    let mut masks = Vec::new();
+    let mut classes = colour_balls_except(&balls, &mut masks, |i| {
+        vq[verts[i] as usize] < opts.threshold
+    });
     drop(vq);
     let mut moved = 0;
     let mut scratch = SmoothScratch::default();
-    for class in &classes {
-        let moves: Vec<Option<VertexMove>> = {
-            let mesh = &*mesh;
-            let tq = &tr.tq;
-            let one = |s: &mut SmoothScratch, i: u32| {
-                let ball = balls.ball(i as usize);
-                if ball.is_empty() {
-                    return None;
-                }
-                smooth_vertex(mesh, tq, verts[i as usize], ball, opts, s)
-            };
-            if class.len() < 64 {
-                // Not worth a trip through the thread pool.
-                class.iter().map(|&i| one(&mut scratch, i)).collect()
-            } else {
-                class
-                    .par_iter()
-                    .with_min_len(64)
-                    .map_init(SmoothScratch::default, |s, &i| one(s, i))
-                    .collect()
-            }
-        };
-        for (&i, m) in class.iter().zip(moves) {
+    // Runs of one-vertex classes are smoothed one by one, in order, or
+    // exactly as if, by dependency levels.
+    let mut groups: Vec<Vec<u32>> = Vec::new();
+    let mut c = 0;
+    while c < classes.len() {
+        if classes[c].len() == 1 {
+            let end = (c..classes.len())
+                .find(|&k| classes[k].len() != 1)
+                .unwrap_or(classes.len());
+            let seq: Vec<u32> = classes[c..end].iter().map(|k| k[0]).collect();
+            c = end;
+            groups.extend(sequential_levels(&balls, &seq, &mut masks));
+        } else {
+            groups.push(std::mem::take(&mut classes[c]));
+            c += 1;
+        }
+    }
+    drop(masks);
+    drop(classes);
+    for group in &groups {
+        let moves = decide_moves(mesh, &tr.tq, &balls, &verts, group, opts, &mut scratch);
+        for (&i, m) in group.iter().zip(moves) {
             let Some(m) = m else { continue };
-            let v = verts[i as usize];
-            mesh.set_point(v, m.x);
-            for (&t, &q) in balls.ball(i as usize).iter().zip(&m.qualities) {
-                tr.set(mesh, t, q);
-            }
+            apply_move(
+                mesh,
+                tr,
+                balls.ball(i as usize),
+                verts[i as usize],
+                m,
+                report,
+            );
             moved += 1;
-            report.laplacian_moves += m.laplacian as usize;
-            report.optimized_moves += m.optimized as usize;
         }
     }
     moved
+}
+
+/// Moves `v` (ball `ball`) as `m` says and records the ball's new qualities.
+fn apply_move(
+    mesh: &mut TetMesh,
+    tr: &mut Tracker,
+    ball: &[u32],
+    v: u32,
+    m: VertexMove,
+    report: &mut ImproveReport,
+) {
+    mesh.set_point(v, m.x);
+    for (&t, &q) in ball.iter().zip(&m.qualities) {
+        tr.set(mesh, t, q);
+    }
+    report.laplacian_moves += m.laplacian as usize;
+    report.optimized_moves += m.optimized as usize;
+}
+
+/// The balls of `seq` grouped so that smoothing the groups one after the
+/// other, each group's vertices in any order or at once, is exactly smoothing
+/// `seq` one by one in order: a vertex's group comes after the groups of all
+/// earlier vertices of `seq` sharing a tet with it (its level in the
+/// dependency order), and vertices of one group share no tet. `levels` is
+/// per-tet-slot scratch, all zero on entry and on return.
+fn sequential_levels(balls: &Balls, seq: &[u32], levels: &mut Vec<u64>) -> Vec<Vec<u32>> {
+    let mut groups: Vec<Vec<u32>> = Vec::new();
+    for &i in seq {
+        let ball = balls.ball(i as usize);
+        if let Some(&top) = ball.iter().max() {
+            if levels.len() <= top as usize {
+                levels.resize(top as usize + 1, 0);
+            }
+        }
+        let l = ball.iter().map(|&t| levels[t as usize]).max().unwrap_or(0) + 1;
+        for &t in ball {
+            levels[t as usize] = l;
+        }
+        if groups.len() < l as usize {
+            groups.resize_with(l as usize, Vec::new);
+        }
+        groups[l as usize - 1].push(i);
+    }
+    for &i in seq {
+        for &t in balls.ball(i as usize) {
+            levels[t as usize] = 0;
+        }
+    }
+    groups
+}
+
+/// The moves [`smooth_vertex`] decides for the vertices of balls `group`
+/// (no two sharing a tet), in parallel if there are enough of them.
+fn decide_moves(
+    mesh: &TetMesh,
+    tq: &[f64],
+    balls: &Balls,
+    verts: &[u32],
+    group: &[u32],
+    opts: &ImproveOptions,
+    scratch: &mut SmoothScratch,
+) -> Vec<Option<VertexMove>> {
+    let one = |s: &mut SmoothScratch, i: u32| {
+        let ball = balls.ball(i as usize);
+        if ball.is_empty() {
+            return None;
+        }
+        smooth_vertex(mesh, tq, verts[i as usize], ball, opts, s)
+    };
+    if group.len() < 64 {
+        // Not worth a trip through the thread pool.
+        group.iter().map(|&i| one(scratch, i)).collect()
+    } else {
+        group
+            .par_iter()
+            .with_min_len(32)
+            .map_init(SmoothScratch::default, |s, &i| one(s, i))
+            .collect()
+    }
 }

@@ -1,8 +1,7 @@
 //! Laplacian smoothing: the vertex goes to the centroid of its neighbours
 //! (Field 1988), kept only if the worst tet of its ball improves.
 
-use super::{ball_min_mean_at, ball_stays_positive, tet_points_with, vertex_neighbours};
-use crate::geom::tet_min_sine;
+use super::{ball_min_mean_at, vertex_neighbours, BallPoints};
 use crate::mesh::TetMesh;
 use glam::DVec3;
 
@@ -40,23 +39,38 @@ pub fn laplacian_position(
     scratch: &mut Vec<u32>,
     qualities: &mut Vec<f64>,
 ) -> Option<(DVec3, f64)> {
+    let mut bp = BallPoints::default();
+    bp.load(mesh, v, ball);
+    laplacian_position_in(mesh, v, ball, &bp, now, scratch, qualities)
+}
+
+/// [`laplacian_position`] with the ball's corners already loaded in `bp`.
+pub fn laplacian_position_in(
+    mesh: &TetMesh,
+    v: u32,
+    ball: &[u32],
+    bp: &BallPoints,
+    now: BallNow,
+    scratch: &mut Vec<u32>,
+    qualities: &mut Vec<f64>,
+) -> Option<(DVec3, f64)> {
     let (current, current_mean, first) = (now.worst, now.mean, now.first);
     let x = laplacian_target(mesh, v, ball, scratch);
     // Every tet must end above `current`; any tet at or below it settles the
     // answer, and the likeliest one to be is the one `first` (the caller's
     // worst tet), so it is tried before the others.
-    let quality = |t: u32| tet_min_sine(&tet_points_with(mesh, t, v, x));
-    let head = ball.get(first).map(|&t| quality(t));
+    let quality = |i: usize| bp.quality(i, x);
+    let head = (first < bp.len()).then(|| quality(first));
     if head.is_some_and(|s| s.is_nan() || s <= current) {
         return None;
     }
     qualities.clear();
     let mut q = f64::INFINITY;
     let mut sum = 0.0;
-    for (i, &t) in ball.iter().enumerate() {
+    for i in 0..bp.len() {
         let s = match head {
             Some(h) if i == first => h,
-            _ => quality(t),
+            _ => quality(i),
         };
         if s.is_nan() || s <= current {
             return None;
@@ -66,7 +80,7 @@ pub fn laplacian_position(
         qualities.push(s);
     }
     let mean = sum / ball.len().max(1) as f64;
-    (mean >= current_mean && ball_stays_positive(mesh, v, ball, x)).then_some((x, q))
+    (mean >= current_mean && bp.stays_positive(x)).then_some((x, q))
 }
 
 /// Moves `v` to its Laplacian target if that raises the ball's worst quality

@@ -99,3 +99,92 @@ pub fn vertex_neighbours(mesh: &TetMesh, v: u32, ball: &[u32], out: &mut Vec<u32
         }
     });
 }
+
+/// The corners of every tet of a vertex's ball, loaded once, so that the
+/// ball's qualities with the vertex at trial positions need no lookups in the
+/// mesh. Each evaluation computes exactly what [`tet_points_with`] followed by
+/// [`tet_min_sine`] (or [`orient3d`]) computes.
+#[derive(Clone, Debug, Default)]
+pub struct BallPoints {
+    /// Corners of each ball tet, as stored in the mesh.
+    pts: Vec<[DVec3; 4]>,
+    /// Position of the vertex among each tet's corners (4: not a corner).
+    at: Vec<u8>,
+}
+
+impl BallPoints {
+    /// Loads the corners of the tets of `ball`, the ball of `v`.
+    pub fn load(&mut self, mesh: &TetMesh, v: u32, ball: &[u32]) {
+        self.pts.clear();
+        self.at.clear();
+        for &t in ball {
+            let tv = mesh.tet(t);
+            self.pts.push(mesh.tet_points(t));
+            self.at
+                .push(tv.iter().position(|&u| u == v).map_or(4, |i| i as u8));
+        }
+    }
+
+    /// Number of tets.
+    pub fn len(&self) -> usize {
+        self.pts.len()
+    }
+
+    /// Whether the ball is empty.
+    pub fn is_empty(&self) -> bool {
+        self.pts.is_empty()
+    }
+
+    /// Corners of tet `i` of the ball with the vertex at `x`.
+    #[inline]
+    pub fn tet_with(&self, i: usize, x: DVec3) -> [DVec3; 4] {
+        let mut p = self.pts[i];
+        if let Some(c) = p.get_mut(self.at[i] as usize) {
+            *c = x;
+        }
+        p
+    }
+
+    /// The other corners of tet `i` (those that are not the vertex), in order.
+    pub fn others(&self, i: usize) -> impl Iterator<Item = DVec3> + '_ {
+        let a = self.at[i] as usize;
+        self.pts[i]
+            .iter()
+            .enumerate()
+            .filter(move |&(k, _)| k != a)
+            .map(|(_, &p)| p)
+    }
+
+    /// Quality of tet `i` with the vertex at `x`.
+    #[inline]
+    pub fn quality(&self, i: usize, x: DVec3) -> f64 {
+        tet_min_sine(&self.tet_with(i, x))
+    }
+
+    /// The ball's qualities with the vertex at `x`, into `out` (cleared
+    /// first), if every one is above `bar` (a NaN quality counts as above,
+    /// as `f64::min` ignores it); `None` at the first that is not.
+    /// On success returns the smallest (NaN ignored).
+    pub fn qualities_above(&self, x: DVec3, bar: f64, out: &mut Vec<f64>) -> Option<f64> {
+        out.clear();
+        let mut q = f64::INFINITY;
+        for i in 0..self.pts.len() {
+            let s = self.quality(i, x);
+            if s <= bar {
+                return None;
+            }
+            q = q.min(s);
+            out.push(s);
+        }
+        Some(q)
+    }
+
+    /// Whether every tet stays positively oriented (exact predicate) with the
+    /// vertex at `x`.
+    pub fn stays_positive(&self, x: DVec3) -> bool {
+        (0..self.pts.len()).all(|i| {
+            let p = self.tet_with(i, x);
+            orient3d(p[0], p[1], p[2], p[3]) > 0.0
+        })
+    }
+}

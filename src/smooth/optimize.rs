@@ -11,8 +11,7 @@
 //! is accepted only if the ball's minimum rises and no tet inverts (exact
 //! predicate); otherwise it is halved, a few times, and then the search stops.
 
-use super::{ball_quality_at, ball_stays_positive};
-use crate::geom::tet_min_sine;
+use super::BallPoints;
 use crate::mesh::TetMesh;
 use glam::DVec3;
 
@@ -35,11 +34,6 @@ impl Default for OptimizeParams {
             halvings: 10,
         }
     }
-}
-
-fn tet_quality_with(mesh: &TetMesh, t: u32, v: u32, x: DVec3) -> f64 {
-    let p = super::tet_points_with(mesh, t, v, x);
-    tet_min_sine(&p)
 }
 
 /// Minimum-norm point of the convex hull of `g` (a few Gilbert iterations):
@@ -92,16 +86,29 @@ pub fn optimize_position(
     ball: &[u32],
     params: &OptimizeParams,
 ) -> Option<(DVec3, f64)> {
+    let mut bp = BallPoints::default();
+    bp.load(mesh, v, ball);
+    optimize_position_in(&bp, x0, params, &mut Vec::new(), &mut Vec::new())
+}
+
+/// [`optimize_position`] with the ball's corners loaded in `bp`. On success
+/// `qs` holds the ball's qualities at the new position, in ball order; `trial`
+/// is scratch.
+pub fn optimize_position_in(
+    bp: &BallPoints,
+    x0: DVec3,
+    params: &OptimizeParams,
+    qs: &mut Vec<f64>,
+    trial: &mut Vec<f64>,
+) -> Option<(DVec3, f64)> {
     // A length scale for differences and steps: mean distance to the ball's
     // other vertices.
     let mut scale = 0.0;
     let mut n = 0;
-    for &t in ball {
-        for u in mesh.tet(t) {
-            if u != v {
-                scale += (mesh.point(u) - x0).length();
-                n += 1;
-            }
+    for i in 0..bp.len() {
+        for u in bp.others(i) {
+            scale += (u - x0).length();
+            n += 1;
         }
     }
     if n == 0 {
@@ -110,25 +117,22 @@ pub fn optimize_position(
     scale /= n as f64;
     let h = 1e-6 * scale;
     let mut x = x0;
-    let mut q = ball_quality_at(mesh, v, ball, x);
+    qs.clear();
+    qs.extend((0..bp.len()).map(|i| bp.quality(i, x)));
+    let mut q = qs.iter().copied().fold(f64::INFINITY, f64::min);
     let start = q;
-    let mut qs: Vec<f64> = Vec::with_capacity(ball.len());
     let mut grads: Vec<DVec3> = Vec::new();
     for _ in 0..params.iterations {
-        qs.clear();
-        qs.extend(ball.iter().map(|&t| tet_quality_with(mesh, t, v, x)));
         grads.clear();
-        for (i, &t) in ball.iter().enumerate() {
-            if qs[i] > q + params.active_tol {
+        for (i, &qi) in qs.iter().enumerate() {
+            if qi > q + params.active_tol {
                 continue;
             }
             let mut g = DVec3::ZERO;
             for axis in 0..3 {
                 let mut e = DVec3::ZERO;
                 e[axis] = h;
-                g[axis] = (tet_quality_with(mesh, t, v, x + e)
-                    - tet_quality_with(mesh, t, v, x - e))
-                    / (2.0 * h);
+                g[axis] = (bp.quality(i, x + e) - bp.quality(i, x - e)) / (2.0 * h);
             }
             grads.push(g);
         }
@@ -156,12 +160,16 @@ pub fn optimize_position(
         let mut moved = false;
         for _ in 0..params.halvings {
             let y = x + alpha * d;
-            let qy = ball_quality_at(mesh, v, ball, y);
-            if qy > q + 1e-12 && ball_stays_positive(mesh, v, ball, y) {
-                x = y;
-                q = qy;
-                moved = true;
-                break;
+            // Accepted only if the ball's minimum rises by more than 1e-12:
+            // the first tet at or below that settles a rejection.
+            if let Some(qy) = bp.qualities_above(y, q + 1e-12, trial) {
+                if bp.stays_positive(y) {
+                    x = y;
+                    q = qy;
+                    std::mem::swap(qs, trial);
+                    moved = true;
+                    break;
+                }
             }
             alpha *= 0.5;
         }
