@@ -219,6 +219,56 @@ impl FlipBatch {
     pub fn refuse(&mut self, i: usize) {
         self.flips[i].ok = false;
     }
+
+    /// The index of the flip whose lower slot is `t`, if any (each child
+    /// takes part in at most one flip; the flips are sorted by that slot).
+    pub(crate) fn index_of_slot(&self, t: u32) -> Option<usize> {
+        self.flips.binary_search_by_key(&t, |fl| fl.t).ok()
+    }
+
+    /// The two old tets of flip `i`: `(t, u)`, `t < u`.
+    pub(crate) fn slots(&self, i: usize) -> (u32, u32) {
+        (self.flips[i].t, self.flips[i].u)
+    }
+
+    /// The face `[a, b, c]` of flip `i` and its two apexes `p` (in `t`) and
+    /// `q` (in `u`).
+    pub(crate) fn face_and_apexes(&self, tets: &[[u32; 4]], i: usize) -> ([u32; 3], u32, u32) {
+        let fl = self.flips[i];
+        let [n0, n1, _] = fl.new_tets(tets[fl.t as usize], tets[fl.u as usize]);
+        ([n0[0], n0[1], n1[1]], n0[2], n0[3])
+    }
+
+    /// Whether flip `i` would give three positive tets with the points
+    /// `moved[j].0` at `moved[j].1` instead of where they are (exact
+    /// predicate).
+    pub(crate) fn positive_with(
+        &self,
+        tets: &[[u32; 4]],
+        points: &[DVec3],
+        i: usize,
+        moved: &[(u32, DVec3)],
+    ) -> bool {
+        let fl = self.flips[i];
+        let at = |x: u32| {
+            moved
+                .iter()
+                .find(|m| m.0 == x)
+                .map_or(points[x as usize], |m| m.1)
+        };
+        fl.new_tets(tets[fl.t as usize], tets[fl.u as usize])
+            .iter()
+            .all(|v| {
+                let p = v.map(at);
+                orient3d(p[0], p[1], p[2], p[3]) > 0.0
+            })
+    }
+
+    /// Judges flip `i` again on the current points.
+    pub(crate) fn rejudge(&mut self, mesh: &TetMesh, i: usize) {
+        let ok = self.flips[i].positive(&mesh.tets, &mesh.points);
+        self.flips[i].ok = ok;
+    }
 }
 
 /// 2-3 flips all valid faces of `batch` at once (made by
