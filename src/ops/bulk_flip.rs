@@ -142,34 +142,64 @@ impl FlipBatch {
     /// ([`is_constrained_face`]). Each face once, as `(t, f)` with `t` the
     /// lower slot, in ascending `t`; each flip is marked valid when its three
     /// new tets are positive (exact predicate, as [`super::flip23_valid`]).
+    ///
+    /// The batch is counted first and then filled in place, block by block,
+    /// so that it is allocated once at its exact size (no collect through
+    /// per-thread lists, which would hold it twice).
     pub fn barycentre_faces(mesh: &TetMesh, first_barycentre: u32) -> FlipBatch {
+        const BLOCK: usize = 1 << 14;
         let first = first_barycentre;
         let (tets, points) = (&mesh.tets, &mesh.points);
-        let flips = (0..tets.len() as u32)
+        // The face of `t` to flip (local index) and the tet across it.
+        let candidate = |t: u32| -> Option<(usize, u32)> {
+            let v = tets[t as usize];
+            if v[0] == DEAD {
+                return None;
+            }
+            let mut bary = (0..4).filter(|&j| v[j] >= first);
+            let i = bary.next()?;
+            if bary.next().is_some() {
+                return None;
+            }
+            let h = mesh.adj[t as usize][i];
+            if h == NO_ADJ {
+                return None;
+            }
+            let (u, g) = TetMesh::half_face(h);
+            if u < t || tets[u as usize][g] < first || is_constrained_face(mesh, t, i) {
+                return None;
+            }
+            Some((i, u))
+        };
+        let n = tets.len();
+        let block = |b: usize| (b * BLOCK) as u32..((b + 1) * BLOCK).min(n) as u32;
+        let counts: Vec<usize> = (0..n.div_ceil(BLOCK))
             .into_par_iter()
-            .filter_map(|t| {
-                let v = tets[t as usize];
-                if v[0] == DEAD {
-                    return None;
-                }
-                let mut bary = (0..4).filter(|&j| v[j] >= first);
-                let i = bary.next()?;
-                if bary.next().is_some() {
-                    return None;
-                }
-                let h = mesh.adj[t as usize][i];
-                if h == NO_ADJ {
-                    return None;
-                }
-                let (u, g) = TetMesh::half_face(h);
-                if u < t || tets[u as usize][g] < first || is_constrained_face(mesh, t, i) {
-                    return None;
-                }
+            .map(|b| block(b).filter(|&t| candidate(t).is_some()).count())
+            .collect();
+        let empty = Flip {
+            t: 0,
+            u: 0,
+            s: 0,
+            code: 0,
+            ok: false,
+        };
+        let mut flips = vec![empty; counts.iter().sum()];
+        let mut parts = Vec::with_capacity(counts.len());
+        let mut rest = &mut flips[..];
+        for &c in &counts {
+            let (part, tail) = rest.split_at_mut(c);
+            parts.push(part);
+            rest = tail;
+        }
+        parts.into_par_iter().enumerate().for_each(|(b, part)| {
+            let found = block(b).filter_map(|t| candidate(t).map(|(i, u)| (t, i, u)));
+            for (slot, (t, i, u)) in part.iter_mut().zip(found) {
                 let mut fl = Flip::new(tets, t, i, u);
                 fl.ok = fl.positive(tets, points);
-                Some(fl)
-            })
-            .collect();
+                *slot = fl;
+            }
+        });
         FlipBatch { flips }
     }
 
