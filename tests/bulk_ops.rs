@@ -465,4 +465,5 @@ fn parallel_flip_repair_equals_the_one_by_one_repair_on_the_refined_tripod() {
     let (moved, before, after, dependent) = compare_repairs(&mesh);
     assert!(before > 0 && moved > 0, "{moved} moved of {before}");
     assert!(after < before);
+    assert!(dependent > 0, "no dependent repairs");
 }
