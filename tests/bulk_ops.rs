@@ -8,7 +8,10 @@
 use tetrefine::geom::{orient3d, TET_EDGES};
 use tetrefine::io::load_mesh;
 use tetrefine::mesh::generate::cube_grid;
-use tetrefine::ops::{flip23, flip23_bulk, flip23_valid, flip32, split14, split14_bulk, FlipBatch};
+use tetrefine::ops::{
+    flip23, flip23_bulk, flip23_valid, flip32, make_flips_valid, split14, split14_bulk, FlipBatch,
+};
+use tetrefine::smooth::ball_stays_positive;
 use tetrefine::TetMesh;
 
 /// The old split phase: `split14` on the selected tets in ascending order.
@@ -291,4 +294,176 @@ fn the_flip_phase_repairs_an_invalid_flip_and_then_flips_in_bulk() {
     assert_eq!((r.flipped, r.refused_flips), (1, 0));
     assert_eq!(mesh.n_tets(), 9);
     assert!((volume6(&mesh) - vol0).abs() <= 1e-12 * vol0);
+}
+
+/// The one-by-one repair the parallel [`make_flips_valid`] must equal: for
+/// each initially invalid flip in batch order, pull both barycentres towards
+/// the face's centroid by the first factor of 0.7, 0.5, 0.3, 0.15, 0.05 that
+/// keeps their balls positive, makes the flip valid and keeps every other
+/// flip of theirs that was valid valid. Returns the number of points moved.
+fn repair_one_by_one(mesh: &mut TetMesh, faces: &[(u32, usize)]) -> usize {
+    let apexes = |m: &TetMesh, t: u32, f: usize| {
+        let (u, g) = TetMesh::half_face(m.adj(t)[f]);
+        (m.tet(t)[f], m.tet(u)[g])
+    };
+    let invalid: Vec<(u32, usize)> = faces
+        .iter()
+        .copied()
+        .filter(|&(t, f)| !flip23_valid(mesh, t, f))
+        .collect();
+    let mut moved = 0;
+    let mut ball = Vec::new();
+    for (t, f) in invalid {
+        let (p, q) = apexes(mesh, t, f);
+        let fv = mesh.face_vertices(t, f);
+        let c = (mesh.point(fv[0]) + mesh.point(fv[1]) + mesh.point(fv[2])) / 3.0;
+        let (p0, q0) = (mesh.point(p), mesh.point(q));
+        // Every other flip with p or q as an apex, by a plain scan.
+        let others: Vec<(u32, usize)> = faces
+            .iter()
+            .copied()
+            .filter(|&x| x != (t, f))
+            .filter(|&(a, b)| {
+                let (x, y) = apexes(mesh, a, b);
+                [p, q].contains(&x) || [p, q].contains(&y)
+            })
+            .collect();
+        let was_valid: Vec<bool> = others
+            .iter()
+            .map(|&(a, b)| flip23_valid(mesh, a, b))
+            .collect();
+        for s in [0.7, 0.5, 0.3, 0.15, 0.05] {
+            let (p1, q1) = (c + (p0 - c) * s, c + (q0 - c) * s);
+            mesh.ball(p, &mut ball);
+            let p_ok = ball_stays_positive(mesh, p, &ball, p1);
+            mesh.ball(q, &mut ball);
+            let q_ok = ball_stays_positive(mesh, q, &ball, q1);
+            if !(p_ok && q_ok) {
+                continue;
+            }
+            mesh.set_point(p, p1);
+            mesh.set_point(q, q1);
+            let ok = flip23_valid(mesh, t, f)
+                && others
+                    .iter()
+                    .zip(&was_valid)
+                    .all(|(&(a, b), &w)| !w || flip23_valid(mesh, a, b));
+            if ok {
+                moved += 2;
+                break;
+            }
+            mesh.set_point(p, p0);
+            mesh.set_point(q, q0);
+        }
+    }
+    moved
+}
+
+/// Splits `mesh`, repairs the flips one by one and with
+/// [`make_flips_valid`] on one and two threads: the same points move to the
+/// same places (bit for bit), the batch's verdicts equal `flip23_valid` on
+/// the repaired mesh, and no tet is inverted. Returns (moved, invalid before,
+/// invalid after, dependent pairs of repairs).
+fn compare_repairs(mesh: &TetMesh) -> (usize, usize, usize, usize) {
+    let first = mesh.n_points() as u32;
+    let mut split = mesh.clone();
+    split14_bulk(&mut split, None);
+    let faces = FlipBatch::barycentre_faces(&split, first).faces();
+    let invalid_before = faces
+        .iter()
+        .filter(|&&(t, f)| !flip23_valid(&split, t, f))
+        .count();
+    let dependent = dependent_repairs(&split, &faces);
+    let mut seq = split.clone();
+    let moved_seq = repair_one_by_one(&mut seq, &faces);
+    for threads in [1, 2] {
+        let mut m = split.clone();
+        let (moved, batch) = with_threads(threads, || {
+            let mut b = FlipBatch::barycentre_faces(&m, first);
+            (make_flips_valid(&mut m, &mut b), b)
+        });
+        assert_eq!(moved, moved_seq, "{threads} threads");
+        for (v, (a, b)) in m.points().iter().zip(seq.points()).enumerate() {
+            assert_eq!(
+                a.to_array().map(f64::to_bits),
+                b.to_array().map(f64::to_bits),
+                "point {v}"
+            );
+        }
+        for (i, &(t, f)) in faces.iter().enumerate() {
+            assert_eq!(batch.is_valid(i), flip23_valid(&seq, t, f), "flip {i}");
+        }
+        m.check().unwrap();
+        assert!(m.tet_ids().all(|t| {
+            let p = m.tet_points(t);
+            orient3d(p[0], p[1], p[2], p[3]) > 0.0
+        }));
+    }
+    let invalid_after = faces
+        .iter()
+        .filter(|&&(t, f)| !flip23_valid(&seq, t, f))
+        .count();
+    (moved_seq, invalid_before, invalid_after, dependent)
+}
+
+/// Pairs of initially invalid flips whose repairs reach a common barycentre
+/// (they share an apex, or a flip joins an apex of one to an apex of the
+/// other): the repair done first changes what the other sees.
+fn dependent_repairs(mesh: &TetMesh, faces: &[(u32, usize)]) -> usize {
+    let apexes = |t: u32, f: usize| {
+        let (u, g) = TetMesh::half_face(mesh.adj(t)[f]);
+        [mesh.tet(t)[f], mesh.tet(u)[g]]
+    };
+    let mut owners: std::collections::HashMap<u32, Vec<usize>> = Default::default();
+    for (i, &(t, f)) in faces.iter().enumerate() {
+        if !flip23_valid(mesh, t, f) {
+            for x in apexes(t, f) {
+                owners.entry(x).or_default().push(i);
+            }
+        }
+    }
+    let mut pairs = std::collections::BTreeSet::new();
+    for &(t, f) in faces {
+        let [x, y] = apexes(t, f);
+        let none = Vec::new();
+        let (a, b) = (
+            owners.get(&x).unwrap_or(&none),
+            owners.get(&y).unwrap_or(&none),
+        );
+        for &i in a.iter().chain(b) {
+            for &j in a.iter().chain(b) {
+                if i < j {
+                    pairs.insert((i, j));
+                }
+            }
+        }
+    }
+    pairs.len()
+}
+
+/// After a full √3 step (optimize included) of a jittered cube, the next
+/// split has invalid flips, some of them dependent (repairs that reach the
+/// same barycentres and must be done in batch order): the parallel repair
+/// makes the very moves of the one-by-one repair.
+#[test]
+fn parallel_flip_repair_equals_the_one_by_one_repair_after_a_step() {
+    use tetrefine::refine::{refine_step, RefineOptions};
+    let mut mesh = jittered_cube(4, 3);
+    refine_step(&mut mesh, 1, &RefineOptions::default());
+    let (moved, before, after, dependent) = compare_repairs(&mesh);
+    assert!(before > 0 && moved > 0, "{moved} moved of {before}");
+    assert!(after < before);
+    assert!(dependent > 0, "no dependent repairs");
+}
+
+/// The same on the tripod (a real mesh with three regions) after one step.
+#[test]
+fn parallel_flip_repair_equals_the_one_by_one_repair_on_the_refined_tripod() {
+    use tetrefine::refine::{refine_step, RefineOptions};
+    let (mut mesh, _) = load_mesh(std::path::Path::new("meshes/tripod.mesh")).unwrap();
+    refine_step(&mut mesh, 1, &RefineOptions::default());
+    let (moved, before, after, dependent) = compare_repairs(&mesh);
+    assert!(before > 0 && moved > 0, "{moved} moved of {before}");
+    assert!(after < before);
+    assert!(dependent > 0, "no dependent repairs");
 }

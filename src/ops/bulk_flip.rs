@@ -142,34 +142,64 @@ impl FlipBatch {
     /// ([`is_constrained_face`]). Each face once, as `(t, f)` with `t` the
     /// lower slot, in ascending `t`; each flip is marked valid when its three
     /// new tets are positive (exact predicate, as [`super::flip23_valid`]).
+    ///
+    /// The batch is counted first and then filled in place, block by block,
+    /// so that it is allocated once at its exact size (no collect through
+    /// per-thread lists, which would hold it twice).
     pub fn barycentre_faces(mesh: &TetMesh, first_barycentre: u32) -> FlipBatch {
+        const BLOCK: usize = 1 << 14;
         let first = first_barycentre;
         let (tets, points) = (&mesh.tets, &mesh.points);
-        let flips = (0..tets.len() as u32)
+        // The face of `t` to flip (local index) and the tet across it.
+        let candidate = |t: u32| -> Option<(usize, u32)> {
+            let v = tets[t as usize];
+            if v[0] == DEAD {
+                return None;
+            }
+            let mut bary = (0..4).filter(|&j| v[j] >= first);
+            let i = bary.next()?;
+            if bary.next().is_some() {
+                return None;
+            }
+            let h = mesh.adj[t as usize][i];
+            if h == NO_ADJ {
+                return None;
+            }
+            let (u, g) = TetMesh::half_face(h);
+            if u < t || tets[u as usize][g] < first || is_constrained_face(mesh, t, i) {
+                return None;
+            }
+            Some((i, u))
+        };
+        let n = tets.len();
+        let block = |b: usize| (b * BLOCK) as u32..((b + 1) * BLOCK).min(n) as u32;
+        let counts: Vec<usize> = (0..n.div_ceil(BLOCK))
             .into_par_iter()
-            .filter_map(|t| {
-                let v = tets[t as usize];
-                if v[0] == DEAD {
-                    return None;
-                }
-                let mut bary = (0..4).filter(|&j| v[j] >= first);
-                let i = bary.next()?;
-                if bary.next().is_some() {
-                    return None;
-                }
-                let h = mesh.adj[t as usize][i];
-                if h == NO_ADJ {
-                    return None;
-                }
-                let (u, g) = TetMesh::half_face(h);
-                if u < t || tets[u as usize][g] < first || is_constrained_face(mesh, t, i) {
-                    return None;
-                }
+            .map(|b| block(b).filter(|&t| candidate(t).is_some()).count())
+            .collect();
+        let empty = Flip {
+            t: 0,
+            u: 0,
+            s: 0,
+            code: 0,
+            ok: false,
+        };
+        let mut flips = vec![empty; counts.iter().sum()];
+        let mut parts = Vec::with_capacity(counts.len());
+        let mut rest = &mut flips[..];
+        for &c in &counts {
+            let (part, tail) = rest.split_at_mut(c);
+            parts.push(part);
+            rest = tail;
+        }
+        parts.into_par_iter().enumerate().for_each(|(b, part)| {
+            let found = block(b).filter_map(|t| candidate(t).map(|(i, u)| (t, i, u)));
+            for (slot, (t, i, u)) in part.iter_mut().zip(found) {
                 let mut fl = Flip::new(tets, t, i, u);
                 fl.ok = fl.positive(tets, points);
-                Some(fl)
-            })
-            .collect();
+                *slot = fl;
+            }
+        });
         FlipBatch { flips }
     }
 
@@ -218,6 +248,56 @@ impl FlipBatch {
     /// Refuses flip `i` (it will not be done).
     pub fn refuse(&mut self, i: usize) {
         self.flips[i].ok = false;
+    }
+
+    /// The index of the flip whose lower slot is `t`, if any (each child
+    /// takes part in at most one flip; the flips are sorted by that slot).
+    pub(crate) fn index_of_slot(&self, t: u32) -> Option<usize> {
+        self.flips.binary_search_by_key(&t, |fl| fl.t).ok()
+    }
+
+    /// The two old tets of flip `i`: `(t, u)`, `t < u`.
+    pub(crate) fn slots(&self, i: usize) -> (u32, u32) {
+        (self.flips[i].t, self.flips[i].u)
+    }
+
+    /// The face `[a, b, c]` of flip `i` and its two apexes `p` (in `t`) and
+    /// `q` (in `u`).
+    pub(crate) fn face_and_apexes(&self, tets: &[[u32; 4]], i: usize) -> ([u32; 3], u32, u32) {
+        let fl = self.flips[i];
+        let [n0, n1, _] = fl.new_tets(tets[fl.t as usize], tets[fl.u as usize]);
+        ([n0[0], n0[1], n1[1]], n0[2], n0[3])
+    }
+
+    /// Whether flip `i` would give three positive tets with the points
+    /// `moved[j].0` at `moved[j].1` instead of where they are (exact
+    /// predicate).
+    pub(crate) fn positive_with(
+        &self,
+        tets: &[[u32; 4]],
+        points: &[DVec3],
+        i: usize,
+        moved: &[(u32, DVec3)],
+    ) -> bool {
+        let fl = self.flips[i];
+        let at = |x: u32| {
+            moved
+                .iter()
+                .find(|m| m.0 == x)
+                .map_or(points[x as usize], |m| m.1)
+        };
+        fl.new_tets(tets[fl.t as usize], tets[fl.u as usize])
+            .iter()
+            .all(|v| {
+                let p = v.map(at);
+                orient3d(p[0], p[1], p[2], p[3]) > 0.0
+            })
+    }
+
+    /// Judges flip `i` again on the current points.
+    pub(crate) fn rejudge(&mut self, mesh: &TetMesh, i: usize) {
+        let ok = self.flips[i].positive(&mesh.tets, &mesh.points);
+        self.flips[i].ok = ok;
     }
 }
 

@@ -5,13 +5,13 @@ use crate::geom::TET_EDGES;
 use crate::mesh::fasthash::FastHashMap;
 use crate::mesh::{edge_key, TetMarks, TetMesh};
 use crate::ops::{
-    flip23_bulk, flip23_valid, is_constrained_face, remove_edge, remove_interface_edge,
+    flip23_bulk, is_constrained_face, make_flips_valid, remove_edge, remove_interface_edge,
     split14_bulk, split_boundary_face, split_interface_face, trisect_edge, EdgeRing, FlipBatch,
 };
 use crate::smooth::{ball_stays_positive, improve, ImproveOptions};
 use crate::surface::sqrt3::sqrt3_positions_trisecting;
 use glam::DVec3;
-use std::collections::{HashMap, HashSet};
+use std::collections::HashSet;
 use std::time::Instant;
 
 /// Runs `steps` refinement steps; one report per step.
@@ -159,99 +159,16 @@ fn split_phase(mesh: &mut TetMesh, opts: &RefineOptions, report: &mut StepReport
 
 /// Phase 2: 2-3 flip of each old interior face whose two tets were both split:
 /// the children holding it have the two barycentres as apexes. Validity is
-/// decided in parallel, the rare invalid flips are repaired one by one
-/// ([`make_flips_valid`]), then all valid flips are done in bulk
+/// decided in parallel, the rare invalid flips are repaired by moving their
+/// barycentres ([`make_flips_valid`]), then all valid flips are done in bulk
 /// ([`flip23_bulk`]).
 fn flip_phase(mesh: &mut TetMesh, st: &StepState, report: &mut StepReport) {
-    let first = st.first_barycentre;
-    let mut batch = FlipBatch::barycentre_faces(mesh, first);
-    let invalid = batch.invalid_faces();
-    if !invalid.is_empty() && make_flips_valid(mesh, first, &batch.faces(), &invalid, report) {
-        batch.revalidate(mesh);
-    }
+    let mut batch = FlipBatch::barycentre_faces(mesh, st.first_barycentre);
+    report.moved_barycentres += make_flips_valid(mesh, &mut batch);
     let n = batch.len();
     let flipped = flip23_bulk(mesh, batch);
     report.flipped += flipped;
     report.refused_flips += n - flipped;
-}
-
-/// Where the segment between two barycentres misses their shared face (the
-/// input violates the precondition the paper borrows from Lehner), both
-/// barycentres are pulled towards the face's centroid — they stay strictly
-/// inside their parents, so the children stay valid — as long as no other
-/// flip of theirs that was valid becomes invalid. The optimize phase moves
-/// these points again later. Counted in `StepReport::moved_barycentres`.
-/// Returns whether any point moved.
-fn make_flips_valid(
-    mesh: &mut TetMesh,
-    first: u32,
-    faces: &[(u32, usize)],
-    invalid: &[(u32, usize)],
-    report: &mut StepReport,
-) -> bool {
-    let mut moved = false;
-    // The flip faces around each barycentre, to re-check its other flips.
-    let mut around: HashMap<u32, Vec<(u32, usize)>> = HashMap::new();
-    for &(t, f) in faces {
-        let p = mesh.tet(t)[f];
-        let h = mesh.adj(t)[f];
-        let (u, g) = TetMesh::half_face(h);
-        let q = mesh.tet(u)[g];
-        around.entry(p).or_default().push((t, f));
-        around.entry(q).or_default().push((t, f));
-    }
-    let mut ball = Vec::new();
-    for &(t, f) in invalid {
-        let h = mesh.adj(t)[f];
-        let (u, g) = TetMesh::half_face(h);
-        let (p, q) = (mesh.tet(t)[f], mesh.tet(u)[g]);
-        debug_assert!(p >= first && q >= first);
-        let fv = mesh.face_vertices(t, f);
-        let centroid = (mesh.point(fv[0]) + mesh.point(fv[1]) + mesh.point(fv[2])) / 3.0;
-        let (p0, q0) = (mesh.point(p), mesh.point(q));
-        let others: Vec<(u32, usize)> = around[&p]
-            .iter()
-            .chain(&around[&q])
-            .copied()
-            .filter(|&x| x != (t, f))
-            .collect();
-        let was_valid: Vec<bool> = others
-            .iter()
-            .map(|&(a, b)| flip23_valid(mesh, a, b))
-            .collect();
-        let mut fixed = false;
-        for s in [0.7, 0.5, 0.3, 0.15, 0.05] {
-            let (p1, q1) = (
-                centroid + (p0 - centroid) * s,
-                centroid + (q0 - centroid) * s,
-            );
-            mesh.ball(p, &mut ball);
-            let p_ok = ball_stays_positive(mesh, p, &ball, p1);
-            mesh.ball(q, &mut ball);
-            let q_ok = ball_stays_positive(mesh, q, &ball, q1);
-            if !(p_ok && q_ok) {
-                continue;
-            }
-            mesh.set_point(p, p1);
-            mesh.set_point(q, q1);
-            let ok = flip23_valid(mesh, t, f)
-                && others
-                    .iter()
-                    .zip(&was_valid)
-                    .all(|(&(a, b), &w)| !w || flip23_valid(mesh, a, b));
-            if ok {
-                fixed = true;
-                break;
-            }
-            mesh.set_point(p, p0);
-            mesh.set_point(q, q0);
-        }
-        if fixed {
-            report.moved_barycentres += 2;
-            moved = true;
-        }
-    }
-    moved
 }
 
 /// Phase 3: 1-3 split of every boundary face of a split tet at its
