@@ -9,7 +9,7 @@
 //! (closed rings inside one region) are removed, so the domain, its regions
 //! and its tags are untouched.
 
-use super::colour::{colour_balls_except, Balls};
+use super::colour::{colour_balls_except, sequential_levels, Balls};
 use super::laplacian::{laplacian_position_in, BallNow};
 use super::optimize::{optimize_position_in, OptimizeParams};
 use super::ring::{canonicalize_ring, improving_ring_triangulation, RingScratch};
@@ -45,6 +45,10 @@ pub struct ImproveOptions {
     pub movable: Option<Vec<bool>>,
     /// Per tet slot: may its edges be removed? `None`: every tet.
     pub tet_allowed: Option<Vec<bool>>,
+    /// Vertices smoothed per block (see `smooth_pass`): the balls of a block
+    /// are gathered at once, about 90 bytes a vertex, and each block costs a
+    /// scan over the tet slots.
+    pub smooth_block: usize,
 }
 
 impl Default for ImproveOptions {
@@ -57,6 +61,7 @@ impl Default for ImproveOptions {
             max_ring: 10,
             movable: None,
             tet_allowed: None,
+            smooth_block: 1 << 19,
         }
     }
 }
@@ -548,8 +553,12 @@ fn smooth_vertex(
     })
 }
 
-/// Vertex smoothing of dirty movable vertices whose worst tet is poor, colour
-/// class by colour class. Returns the number of vertices moved.
+/// Vertex smoothing of dirty movable vertices whose worst tet is poor, in
+/// blocks of `opts.smooth_block` consecutive vertices (neighbours in space
+/// after the spatial reordering), each block colour class by colour class.
+/// Blocks bound the memory of the balls: gathering all of them at once took
+/// a quarter of a gigabyte on a 14M-tet mesh. Returns the number of vertices
+/// moved.
 fn smooth_pass(
     mesh: &mut TetMesh,
     tr: &mut Tracker,
@@ -569,6 +578,7 @@ fn smooth_pass(
     }
     let bar = opts.threshold.max(opts.laplacian_threshold);
     let mut verts = Vec::new();
+    let mut alone = Vec::new();
     for v in 0..mesh.n_points() {
         if !tr.vert_dirty[v] || !movable[v] {
             continue;
@@ -576,54 +586,53 @@ fn smooth_pass(
         tr.vert_dirty[v] = false;
         if vq[v] < bar {
             verts.push(v as u32);
+            alone.push(vq[v] < opts.threshold);
         }
     }
-    let balls = Balls::gather(mesh, &verts);
-    // The vertices bad enough for optimization-based smoothing are few, and
-    // the worst tets hinge on them: they are smoothed one by one in vertex
-    // order before and after the colour classes (smoothing them only in
-    // colour order lost up to 4.5° of the tripod's worst angle).
-    // Per-slot scratch of the colouring and of the levels, dropped before
-    // the smoothing.
-    let mut masks = Vec::new();
-    let mut classes = colour_balls_except(&balls, &mut masks, |i| {
-        vq[verts[i] as usize] < opts.threshold
-    });
     drop(vq);
     let mut moved = 0;
     let mut scratch = SmoothScratch::default();
-    // Runs of one-vertex classes are smoothed one by one, in order, or
-    // exactly as if, by dependency levels.
-    let mut groups: Vec<Vec<u32>> = Vec::new();
-    let mut c = 0;
-    while c < classes.len() {
-        if classes[c].len() == 1 {
-            let end = (c..classes.len())
-                .find(|&k| classes[k].len() != 1)
-                .unwrap_or(classes.len());
-            let seq: Vec<u32> = classes[c..end].iter().map(|k| k[0]).collect();
-            c = end;
-            groups.extend(sequential_levels(&balls, &seq, &mut masks));
-        } else {
-            groups.push(std::mem::take(&mut classes[c]));
-            c += 1;
+    let mut level = Vec::new();
+    let size = opts.smooth_block.max(1);
+    for (block, alone) in verts.chunks(size).zip(alone.chunks(size)) {
+        let balls = Balls::gather(mesh, block);
+        // The vertices bad enough for optimization-based smoothing are few,
+        // and the worst tets hinge on them: they are smoothed one by one in
+        // vertex order before and after the colour classes (smoothing them
+        // only in colour order lost up to 4.5° of the tripod's worst angle).
+        let mut classes = colour_balls_except(mesh, &balls, block, |i| alone[i]);
+        // Runs of one-vertex classes are smoothed one by one, in order, or
+        // exactly as if, by dependency levels.
+        let mut groups: Vec<Vec<u32>> = Vec::new();
+        let mut c = 0;
+        while c < classes.len() {
+            if classes[c].len() == 1 {
+                let end = (c..classes.len())
+                    .find(|&k| classes[k].len() != 1)
+                    .unwrap_or(classes.len());
+                let seq: Vec<u32> = classes[c..end].iter().map(|k| k[0]).collect();
+                c = end;
+                groups.extend(sequential_levels(mesh, &balls, block, &seq, &mut level));
+            } else {
+                groups.push(std::mem::take(&mut classes[c]));
+                c += 1;
+            }
         }
-    }
-    drop(masks);
-    drop(classes);
-    for group in &groups {
-        let moves = decide_moves(mesh, &tr.tq, &balls, &verts, group, opts, &mut scratch);
-        for (&i, m) in group.iter().zip(moves) {
-            let Some(m) = m else { continue };
-            apply_move(
-                mesh,
-                tr,
-                balls.ball(i as usize),
-                verts[i as usize],
-                m,
-                report,
-            );
-            moved += 1;
+        drop(classes);
+        for group in &groups {
+            let moves = decide_moves(mesh, &tr.tq, &balls, block, group, opts, &mut scratch);
+            for (&i, m) in group.iter().zip(moves) {
+                let Some(m) = m else { continue };
+                apply_move(
+                    mesh,
+                    tr,
+                    balls.ball(i as usize),
+                    block[i as usize],
+                    m,
+                    report,
+                );
+                moved += 1;
+            }
         }
     }
     moved
@@ -644,38 +653,6 @@ fn apply_move(
     }
     report.laplacian_moves += m.laplacian as usize;
     report.optimized_moves += m.optimized as usize;
-}
-
-/// The balls of `seq` grouped so that smoothing the groups one after the
-/// other, each group's vertices in any order or at once, is exactly smoothing
-/// `seq` one by one in order: a vertex's group comes after the groups of all
-/// earlier vertices of `seq` sharing a tet with it (its level in the
-/// dependency order), and vertices of one group share no tet. `levels` is
-/// per-tet-slot scratch, all zero on entry and on return.
-fn sequential_levels(balls: &Balls, seq: &[u32], levels: &mut Vec<u64>) -> Vec<Vec<u32>> {
-    let mut groups: Vec<Vec<u32>> = Vec::new();
-    for &i in seq {
-        let ball = balls.ball(i as usize);
-        if let Some(&top) = ball.iter().max() {
-            if levels.len() <= top as usize {
-                levels.resize(top as usize + 1, 0);
-            }
-        }
-        let l = ball.iter().map(|&t| levels[t as usize]).max().unwrap_or(0) + 1;
-        for &t in ball {
-            levels[t as usize] = l;
-        }
-        if groups.len() < l as usize {
-            groups.resize_with(l as usize, Vec::new);
-        }
-        groups[l as usize - 1].push(i);
-    }
-    for &i in seq {
-        for &t in balls.ball(i as usize) {
-            levels[t as usize] = 0;
-        }
-    }
-    groups
 }
 
 /// The moves [`smooth_vertex`] decides for the vertices of balls `group`
