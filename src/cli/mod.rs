@@ -64,27 +64,42 @@ pub fn write_histogram(path: &Path, stats: &MeshStats) -> CliResult {
     write_hist_file(path, &stats.histogram, &title).map_err(|e| e.to_string())
 }
 
+/// A per-tet integer of a mesh, for [`write_refined`].
+pub type TetValue<'a> = dyn Fn(&TetMesh, u32) -> i32 + Sync + 'a;
+
 /// Writes a refined mesh: compacted, and for `.vtu` with the cell arrays
-/// `level` and `parent` (plus `extra`) besides the standard quality arrays.
-pub fn write_refined(path: &Path, mesh: &mut TetMesh, extra: Vec<CellArray>) -> CliResult {
+/// `level` and `parent` (plus `extra`, named integers per tet) besides the
+/// standard quality arrays.
+pub fn write_refined(
+    path: &Path,
+    mesh: &mut TetMesh,
+    extra: &[(&str, &TetValue<'_>)],
+) -> CliResult {
     mesh.compact();
     let is_vtu = path
         .extension()
         .and_then(|e| e.to_str())
         .is_some_and(|e| e.eq_ignore_ascii_case("vtu"));
     if is_vtu {
-        let ids: Vec<u32> = mesh.tet_ids().collect();
+        // After compaction the i-th live tet is slot i: the arrays are
+        // computed as they are written rather than held.
+        let mesh = &*mesh;
+        let n = mesh.n_tets();
+        let level = |i: usize| i32::from(mesh.level(i as u32));
+        let parent = |i: usize| mesh.parent(i as u32) as i32;
+        let extra: Vec<_> = extra
+            .iter()
+            .map(|&(name, f)| (name, move |i: usize| f(mesh, i as u32)))
+            .collect();
         let mut cells = vec![
-            CellArray::Int32(
-                "level".into(),
-                ids.iter().map(|&t| i32::from(mesh.level(t))).collect(),
-            ),
-            CellArray::Int32(
-                "parent".into(),
-                ids.iter().map(|&t| mesh.parent(t) as i32).collect(),
-            ),
+            CellArray::Int32With("level".into(), n, &level),
+            CellArray::Int32With("parent".into(), n, &parent),
         ];
-        cells.extend(extra);
+        cells.extend(
+            extra
+                .iter()
+                .map(|(name, f)| CellArray::Int32With(name.to_string(), n, f)),
+        );
         tetrefine::io::vtk::write_vtu(path, mesh, &cells).map_err(|e| e.to_string())
     } else {
         tetrefine::io::write_mesh(path, mesh).map_err(|e| e.to_string())

@@ -5,7 +5,6 @@ use super::progress::BarProgress;
 use std::path::PathBuf;
 use std::time::Instant;
 use tetrefine::io::indicator::read_indicator;
-use tetrefine::io::vtk::CellArray;
 use tetrefine::refine::marking::{select, MarkStrategy};
 use tetrefine::refine::step::descendants_of_last_step;
 use tetrefine::refine::{
@@ -229,17 +228,6 @@ pub fn run(a: Args) -> super::CliResult {
             .map_err(|e| e.to_string())?;
     }
     mesh.compact();
-    let marked: Vec<i32> = mesh
-        .tet_ids()
-        .map(|t| {
-            let p = mesh.parent(t) as usize;
-            i32::from(
-                selection
-                    .as_ref()
-                    .is_none_or(|sel| sel.get(p).copied().unwrap_or(false)),
-            )
-        })
-        .collect();
     if let Some(path) = &a.parent_map {
         let ids: Vec<u32> = mesh.tet_ids().collect();
         tetrefine::io::write_atomic(path, |w| {
@@ -255,11 +243,14 @@ pub fn run(a: Args) -> super::CliResult {
         })
         .map_err(|e| e.to_string())?;
     }
-    super::write_refined(
-        &a.output,
-        &mut mesh,
-        vec![CellArray::Int32("marked".into(), marked)],
-    )?;
+    // Whether the tet descends from a selected input tet (all do without a
+    // selection).
+    let sel = selection.as_deref();
+    let marked = |m: &tetrefine::TetMesh, t: u32| {
+        let p = m.parent(t) as usize;
+        i32::from(sel.is_none_or(|s| s.get(p).copied().unwrap_or(false)))
+    };
+    super::write_refined(&a.output, &mut mesh, &[("marked", &marked)])?;
     if let Some(f) = &a.features_out {
         super::write_feature_lines(f, &mesh)?;
     }

@@ -36,18 +36,36 @@ const VTK_TETRA: u8 = 10;
 const BLOCK: usize = 1 << 15;
 
 /// An extra per-tet array for [`write_vtu`]: one value per live tet, in id order.
-#[derive(Clone, Debug, PartialEq)]
-pub enum CellArray {
+pub enum CellArray<'a> {
     /// A 32-bit integer array with its name.
     Int32(String, Vec<i32>),
     /// A 64-bit float array with its name.
     Float64(String, Vec<f64>),
+    /// A 32-bit integer array with its name and length, each value computed
+    /// when it is written (the `i`-th live tet's): a 14M-tet mesh's arrays
+    /// are 56 MB each, which a writer streaming blocks need not hold.
+    Int32With(String, usize, &'a (dyn Fn(usize) -> i32 + Sync)),
 }
 
-impl CellArray {
+impl std::fmt::Debug for CellArray<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let kind = match self {
+            CellArray::Int32(..) | CellArray::Int32With(..) => "Int32",
+            CellArray::Float64(..) => "Float64",
+        };
+        write!(
+            f,
+            "CellArray::{kind}({:?}, {} values)",
+            self.name(),
+            self.len()
+        )
+    }
+}
+
+impl CellArray<'_> {
     fn name(&self) -> &str {
         match self {
-            CellArray::Int32(n, _) | CellArray::Float64(n, _) => n,
+            CellArray::Int32(n, _) | CellArray::Float64(n, _) | CellArray::Int32With(n, ..) => n,
         }
     }
 
@@ -55,6 +73,7 @@ impl CellArray {
         match self {
             CellArray::Int32(_, v) => v.len(),
             CellArray::Float64(_, v) => v.len(),
+            CellArray::Int32With(_, n, _) => *n,
         }
     }
 }
@@ -263,6 +282,7 @@ pub fn write_vtu(path: &Path, mesh: &TetMesh, extra_cells: &[CellArray]) -> Resu
             match a {
                 CellArray::Int32(n, v) => data_array(w, n, v.len(), "", |i| v[i])?,
                 CellArray::Float64(n, v) => data_array(w, n, v.len(), "", |i| v[i])?,
+                CellArray::Int32With(n, len, f) => data_array(w, n, *len, "", f)?,
             }
         }
         writeln!(w, "      </CellData>\n      <Points>")?;
