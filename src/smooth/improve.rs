@@ -241,6 +241,9 @@ struct EdgeRemoval {
     tried: Vec<AtomicU8>,
     /// Per tet slot: in the ring of a recorded removable edge.
     has_found: Vec<bool>,
+    /// Per tet slot: created by a removal of this pass (so not seen by the
+    /// search).
+    born: Vec<bool>,
     /// Per point: a vertex of a cavity re-triangulated in this pass.
     touched: Vec<bool>,
 }
@@ -329,9 +332,14 @@ impl EdgeRemoval {
         // would. Removing an edge changes only tets whose vertices are all in
         // its cavity, so the ring of an edge with an end outside every cavity
         // so far is still the one the search saw: its record (or the lack of
-        // one) stands. Edges with both ends touched are searched again.
+        // one) stands. An edge with both ends touched may have a new ring:
+        // it is gathered again, and searched again only if a tet of its ring
+        // was created in this pass (otherwise the ring, its points and its
+        // qualities are the ones the search saw, and so is the verdict).
         self.touched.clear();
         self.touched.resize(mesh.n_points(), false);
+        self.born.clear();
+        self.born.resize(mesh.n_tet_slots(), false);
         let mut retried: FastHashSet<EdgeKey> = FastHashSet::default();
         let mut removed = 0;
         let mut scratch = EdgeScratch::default();
@@ -342,11 +350,20 @@ impl EdgeRemoval {
             let v = mesh.tet(t);
             for (e, &[i, j]) in TET_EDGES.iter().enumerate() {
                 let key = edge_key(v[i], v[j]);
-                let tri = if self.touched[v[i] as usize] && self.touched[v[j] as usize] {
+                let both_touched = self.touched[v[i] as usize] && self.touched[v[j] as usize];
+                let tri = if both_touched && {
                     if !retried.insert(key) || mesh.is_feature_edge(v[i], v[j]) {
                         continue;
                     }
-                    search_edge(mesh, tr, opts, t, e, &mut scratch)
+                    scratch.ring.gather_into(mesh, t, e);
+                    let born = &self.born;
+                    scratch
+                        .ring
+                        .tets
+                        .iter()
+                        .any(|&u| born.get(u as usize).copied().unwrap_or(false))
+                } {
+                    judge_ring(mesh, tr, opts, &mut scratch)
                 } else if (t as usize) < self.has_found.len() && self.has_found[t as usize] {
                     by_edge.remove(&key).map(|f| {
                         // The ring is the one the search saw: gather it again.
@@ -375,7 +392,11 @@ impl EdgeRemoval {
                 for &x in ring.verts.iter().chain([&ring.a, &ring.b]) {
                     self.touched[x as usize] = true;
                 }
+                if self.born.len() < slots {
+                    self.born.resize(slots, false);
+                }
                 for n in new {
+                    self.born[n as usize] = true;
                     let q = tet_min_sine(&mesh.tet_points(n));
                     tr.set(mesh, n, q);
                     if let Some(a) = &mut tr.allowed {
@@ -404,8 +425,18 @@ fn search_edge(
     e: usize,
     s: &mut EdgeScratch,
 ) -> Option<RingTriangulation> {
+    s.ring.gather_into(mesh, t, e);
+    judge_ring(mesh, tr, opts, s)
+}
+
+/// The verdict of [`search_edge`] on the ring already gathered in `s.ring`.
+fn judge_ring(
+    mesh: &TetMesh,
+    tr: &Tracker,
+    opts: &ImproveOptions,
+    s: &mut EdgeScratch,
+) -> Option<RingTriangulation> {
     let ring = &mut s.ring;
-    ring.gather_into(mesh, t, e);
     if !ring.closed
         || ring.tets.len() > opts.max_ring.min(255) // ring positions are kept as u8
         || !ring.tets.iter().all(|&u| tr.is_allowed(u))
