@@ -61,7 +61,7 @@ impl Default for ImproveOptions {
             max_ring: 10,
             movable: None,
             tet_allowed: None,
-            smooth_block: 1 << 19,
+            smooth_block: 1 << 20,
         }
     }
 }
