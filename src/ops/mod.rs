@@ -7,7 +7,7 @@
 //! flat tet returns [`OpError::WouldInvert`] and leaves the mesh untouched.
 //! The shared re-linking lives here in [`replace_cavity`].
 
-mod bulk;
+pub(crate) mod bulk;
 pub mod bulk_flip;
 pub mod bulk_split;
 pub mod edge_removal;

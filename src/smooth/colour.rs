@@ -16,6 +16,7 @@
 //! colour byte per point rather than a colour mask per tet.
 
 use crate::mesh::{TetMesh, DEAD};
+use crate::ops::bulk::Disjoint;
 use rayon::prelude::*;
 
 /// The balls (incident tets) of a list of vertices, in one flat array.
@@ -90,7 +91,7 @@ impl Balls {
         let mut tets = vec![0u32; at];
         {
             // Each part writes only the positions its counts reserved.
-            let out = SharedSlice(tets.as_mut_ptr());
+            let out = Disjoint::new(&mut tets);
             let out = &out;
             slots
                 .par_chunks(per)
@@ -103,8 +104,8 @@ impl Balls {
                             for &x in tv {
                                 if let Some(i) = position(x) {
                                     // SAFETY: fill[i] runs over this part's
-                                    // own stretch of ball i, inside `tets`.
-                                    unsafe { *out.0.add(fill[i] as usize) = base + k as u32 };
+                                    // own stretch of ball i: one writer.
+                                    unsafe { out.write(fill[i] as usize, base + k as u32) };
                                     fill[i] += 1;
                                 }
                             }
@@ -130,12 +131,6 @@ impl Balls {
         &self.tets[self.offsets[i]..self.offsets[i + 1]]
     }
 }
-
-/// A pointer shared by the threads of [`Balls::gather`], each writing only
-/// its own positions.
-struct SharedSlice(*mut u32);
-// SAFETY: the threads write disjoint positions (see `Balls::gather`).
-unsafe impl Sync for SharedSlice {}
 
 /// Greedy colouring of the balls' vertices `verts` (ball `i` is the ball of
 /// `verts[i]`), visited in order: each takes the smallest colour no earlier
