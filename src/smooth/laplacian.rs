@@ -55,7 +55,9 @@ pub fn laplacian_position_in(
     qualities: &mut Vec<f64>,
 ) -> Option<(DVec3, f64)> {
     let (current, current_mean, first) = (now.worst, now.mean, now.first);
-    let x = laplacian_target(mesh, v, ball, scratch);
+    let x = bp
+        .neighbour_centroid(scratch)
+        .unwrap_or_else(|| mesh.point(v));
     // Every tet must end above `current`; any tet at or below it settles the
     // answer, and the likeliest one to be is the one `first` (the caller's
     // worst tet), so it is tried before the others.

@@ -110,6 +110,8 @@ pub struct BallPoints {
     pts: Vec<[DVec3; 4]>,
     /// Position of the vertex among each tet's corners (4: not a corner).
     at: Vec<u8>,
+    /// Vertex ids of each ball tet, as stored in the mesh.
+    ids: Vec<[u32; 4]>,
 }
 
 impl BallPoints {
@@ -117,12 +119,35 @@ impl BallPoints {
     pub fn load(&mut self, mesh: &TetMesh, v: u32, ball: &[u32]) {
         self.pts.clear();
         self.at.clear();
+        self.ids.clear();
         for &t in ball {
             let tv = mesh.tet(t);
+            self.ids.push(tv);
             self.pts.push(mesh.tet_points(t));
             self.at
                 .push(tv.iter().position(|&u| u == v).map_or(4, |i| i as u8));
         }
+    }
+
+    /// The centroid of the vertex's distinct neighbours (the other corners of
+    /// the ball's tets), summed in the order they first appear in the ball,
+    /// as [`laplacian::laplacian_target`] sums them; `None` for an empty
+    /// ball. `seen` is scratch. Reads only what [`BallPoints::load`] loaded:
+    /// a ball has about fifteen neighbours, so a linear scan of `seen` is
+    /// cheaper than a per-point stamp array.
+    pub fn neighbour_centroid(&self, seen: &mut Vec<u32>) -> Option<DVec3> {
+        seen.clear();
+        let mut sum = DVec3::ZERO;
+        for ((ids, pts), &a) in self.ids.iter().zip(&self.pts).zip(&self.at) {
+            for k in 0..4 {
+                if k == a as usize || seen.contains(&ids[k]) {
+                    continue;
+                }
+                seen.push(ids[k]);
+                sum += pts[k];
+            }
+        }
+        (!seen.is_empty()).then(|| sum / seen.len() as f64)
     }
 
     /// Number of tets.
