@@ -494,7 +494,6 @@ fn search_tet(
 /// Per-thread buffers of vertex smoothing.
 #[derive(Default)]
 struct SmoothScratch {
-    neighbours: Vec<u32>,
     qualities: Vec<f64>,
     trial: Vec<f64>,
     ball: BallPoints,
@@ -544,15 +543,7 @@ fn smooth_vertex(
         first: worst,
     };
     s.ball.load(mesh, v, ball);
-    if let Some((x2, q2)) = laplacian_position_in(
-        mesh,
-        v,
-        ball,
-        &s.ball,
-        now,
-        &mut s.neighbours,
-        &mut s.qualities,
-    ) {
+    if let Some((x2, q2)) = laplacian_position_in(mesh, v, ball, &s.ball, now, &mut s.qualities) {
         x = x2;
         q = q2;
         laplacian = true;

@@ -36,12 +36,11 @@ pub fn laplacian_position(
     v: u32,
     ball: &[u32],
     now: BallNow,
-    scratch: &mut Vec<u32>,
     qualities: &mut Vec<f64>,
 ) -> Option<(DVec3, f64)> {
     let mut bp = BallPoints::default();
     bp.load(mesh, v, ball);
-    laplacian_position_in(mesh, v, ball, &bp, now, scratch, qualities)
+    laplacian_position_in(mesh, v, ball, &bp, now, qualities)
 }
 
 /// [`laplacian_position`] with the ball's corners already loaded in `bp`.
@@ -51,12 +50,11 @@ pub fn laplacian_position_in(
     ball: &[u32],
     bp: &BallPoints,
     now: BallNow,
-    scratch: &mut Vec<u32>,
     qualities: &mut Vec<f64>,
 ) -> Option<(DVec3, f64)> {
     let (current, current_mean, first) = (now.worst, now.mean, now.first);
     let x = bp
-        .neighbour_centroid(scratch)
+        .neighbour_centroid(mesh.n_points(), v)
         .unwrap_or_else(|| mesh.point(v));
     // Every tet must end above `current`; any tet at or below it settles the
     // answer, and the likeliest one to be is the one `first` (the caller's
@@ -88,19 +86,13 @@ pub fn laplacian_position_in(
 /// Moves `v` to its Laplacian target if that raises the ball's worst quality
 /// above `current` without lowering the ball's mean quality or inverting
 /// anything. Returns the new worst quality if it moved.
-pub fn laplacian_smooth(
-    mesh: &mut TetMesh,
-    v: u32,
-    ball: &[u32],
-    current: f64,
-    scratch: &mut Vec<u32>,
-) -> Option<f64> {
+pub fn laplacian_smooth(mesh: &mut TetMesh, v: u32, ball: &[u32], current: f64) -> Option<f64> {
     let now = BallNow {
         worst: current,
         mean: ball_min_mean_at(mesh, v, ball, mesh.point(v)).1,
         first: usize::MAX,
     };
-    let (x, q) = laplacian_position(mesh, v, ball, now, scratch, &mut Vec::new())?;
+    let (x, q) = laplacian_position(mesh, v, ball, now, &mut Vec::new())?;
     mesh.set_point(v, x);
     Some(q)
 }

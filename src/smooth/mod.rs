@@ -72,15 +72,33 @@ pub fn ball_stays_positive(mesh: &TetMesh, v: u32, ball: &[u32], x: DVec3) -> bo
 /// The distinct vertices adjacent to `v` (sharing a tet with it), appended to
 /// `out` (cleared first) in the order they first appear in `ball`.
 pub fn vertex_neighbours(mesh: &TetMesh, v: u32, ball: &[u32], out: &mut Vec<u32>) {
+    out.clear();
+    with_stamps(mesh.n_points(), v, |stamp, epoch| {
+        for &t in ball {
+            for x in mesh.tet(t) {
+                let s = &mut stamp[x as usize];
+                if *s != epoch {
+                    *s = epoch;
+                    out.push(x);
+                }
+            }
+        }
+    });
+}
+
+/// Runs `f` on this thread's "seen in this call" stamps, one per point of a
+/// mesh of `n_points` points, with a fresh epoch: a point is seen when its
+/// stamp equals the epoch, and only `v` is seen at the start. A ball has
+/// about fifteen neighbours among seventy corner entries; a stamp lookup
+/// costs fewer instructions than scanning the list found so far.
+fn with_stamps<R>(n_points: usize, v: u32, f: impl FnOnce(&mut [u32], u32) -> R) -> R {
     thread_local! {
-        /// Per-thread "seen in this call" stamps, one per point.
         static SEEN: RefCell<(Vec<u32>, u32)> = const { RefCell::new((Vec::new(), 0)) };
     }
-    out.clear();
     SEEN.with(|seen| {
         let (stamp, epoch) = &mut *seen.borrow_mut();
-        if stamp.len() < mesh.n_points() {
-            stamp.resize(mesh.n_points(), 0);
+        if stamp.len() < n_points {
+            stamp.resize(n_points, 0);
         }
         *epoch = epoch.wrapping_add(1);
         if *epoch == 0 {
@@ -88,16 +106,8 @@ pub fn vertex_neighbours(mesh: &TetMesh, v: u32, ball: &[u32], out: &mut Vec<u32
             *epoch = 1;
         }
         stamp[v as usize] = *epoch;
-        for &t in ball {
-            for x in mesh.tet(t) {
-                let s = &mut stamp[x as usize];
-                if *s != *epoch {
-                    *s = *epoch;
-                    out.push(x);
-                }
-            }
-        }
-    });
+        f(stamp, *epoch)
+    })
 }
 
 /// The corners of every tet of a vertex's ball, loaded once, so that the
@@ -129,25 +139,27 @@ impl BallPoints {
         }
     }
 
-    /// The centroid of the vertex's distinct neighbours (the other corners of
-    /// the ball's tets), summed in the order they first appear in the ball,
-    /// as [`laplacian::laplacian_target`] sums them; `None` for an empty
-    /// ball. `seen` is scratch. Reads only what [`BallPoints::load`] loaded:
-    /// a ball has about fifteen neighbours, so a linear scan of `seen` is
-    /// cheaper than a per-point stamp array.
-    pub fn neighbour_centroid(&self, seen: &mut Vec<u32>) -> Option<DVec3> {
-        seen.clear();
-        let mut sum = DVec3::ZERO;
-        for ((ids, pts), &a) in self.ids.iter().zip(&self.pts).zip(&self.at) {
-            for k in 0..4 {
-                if k == a as usize || seen.contains(&ids[k]) {
-                    continue;
+    /// The centroid of the distinct neighbours of `v` (the ball's vertex,
+    /// in a mesh of `n_points` points), summed in the order they first
+    /// appear in the ball, as [`laplacian::laplacian_target`] sums them;
+    /// `None` for an empty ball. Reads only what [`BallPoints::load`]
+    /// loaded, so the ball is not walked a second time in the mesh.
+    pub fn neighbour_centroid(&self, n_points: usize, v: u32) -> Option<DVec3> {
+        with_stamps(n_points, v, |stamp, epoch| {
+            let mut sum = DVec3::ZERO;
+            let mut n = 0usize;
+            for (ids, pts) in self.ids.iter().zip(&self.pts) {
+                for (&x, &p) in ids.iter().zip(pts) {
+                    let s = &mut stamp[x as usize];
+                    if *s != epoch {
+                        *s = epoch;
+                        sum += p;
+                        n += 1;
+                    }
                 }
-                seen.push(ids[k]);
-                sum += pts[k];
             }
-        }
-        (!seen.is_empty()).then(|| sum / seen.len() as f64)
+            (n > 0).then(|| sum / n as f64)
+        })
     }
 
     /// Number of tets.
