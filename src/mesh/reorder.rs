@@ -42,12 +42,15 @@ impl TetMesh {
     /// The reordering, with the compaction fused in: the composite old → new
     /// maps are computed straight from the live slots, so every tet array is
     /// moved once. Memory matters here: it runs on the largest mesh of a
-    /// refinement. On top of the mesh it holds at most the 4-byte tet map and
-    /// one 16-byte array per tet slot (20 bytes) plus a few point arrays:
-    /// tets are scattered into a fresh array, adjacency into the old tet
-    /// array, region/level/parent into fresh arrays after the 16-byte one is
-    /// gone. Each pass is parallel and its result does not depend on the
-    /// number of threads.
+    /// refinement. The tet map lives in the generation array's allocation;
+    /// on top of the mesh the reordering holds at most the 4-byte order and
+    /// one 16-byte array per tet slot (20 bytes, where compacting and then
+    /// permuting held 24) plus a few point arrays: tets are gathered into a
+    /// fresh array, adjacency into the old tet array, region/level/parent
+    /// into fresh arrays once the 16-byte one is gone. Fresh memory is
+    /// touched by the parallel passes themselves (page faults cost as much
+    /// as the moves). Each pass is parallel and its result does not depend
+    /// on the number of threads.
     fn reorder(&mut self, want_maps: bool) -> Option<Remap> {
         // Points used by a live tet, numbered in order (the compaction's
         // point map, `DEAD` for unused points).
@@ -121,49 +124,46 @@ impl TetMesh {
         // afterwards): no fresh pages.
         let generation = std::mem::take(&mut self.generation);
         let tmap = self.tet_order(&pmap, np, generation);
-        let nt = self.tets.len() - tmap.dead;
-        let tmap = tmap.map;
+        let TetOrder { map: tmap, order } = tmap;
+        let nt = order.len();
+        // Gathered in the new order: the writes stream, and the reads of
+        // spatial neighbours (their slots and tet map entries) stay close.
         // Tets into a fresh array, adjacency into the old tet array. Fresh
         // arrays are zeroed by the allocator: their pages are faulted by the
         // parallel writes rather than by a sequential fill.
         let mut tets = vec![[0u32; 4]; nt];
-        scatter(&mut tets, &self.tets, &tmap, |v| {
-            v.map(|x| pmap[x as usize])
-        });
+        tets.par_iter_mut()
+            .zip(order.par_iter())
+            .for_each(|(v, &t)| {
+                *v = self.tets[t as usize].map(|x| pmap[x as usize]);
+            });
         let mut adj = std::mem::replace(&mut self.tets, tets);
         adj.truncate(nt);
-        scatter(&mut adj, &self.adj, &tmap, |a| {
-            a.map(|h| {
-                if h == NO_ADJ {
-                    NO_ADJ
-                } else {
-                    4 * tmap[(h >> 2) as usize] + (h & 3)
-                }
-            })
-        });
+        adj.par_iter_mut()
+            .zip(order.par_iter())
+            .for_each(|(a, &t)| {
+                *a = self.adj[t as usize].map(|h| {
+                    if h == NO_ADJ {
+                        NO_ADJ
+                    } else {
+                        4 * tmap[(h >> 2) as usize] + (h & 3)
+                    }
+                });
+            });
         self.adj = adj;
         let mut region = vec![0i32; nt];
         let mut level = vec![0u8; nt];
         let mut parent = vec![0u32; nt];
-        {
-            let (r, l, p) = (
-                Disjoint::new(&mut region),
-                Disjoint::new(&mut level),
-                Disjoint::new(&mut parent),
-            );
-            let (r, l, p) = (&r, &l, &p);
-            tmap.par_iter().enumerate().for_each(|(t, &m)| {
-                if m != DEAD {
-                    let m = m as usize;
-                    // SAFETY: the tet map is one-to-one: one writer each.
-                    unsafe {
-                        r.write(m, self.region[t]);
-                        l.write(m, self.level[t]);
-                        p.write(m, self.parent[t]);
-                    }
-                }
+        region
+            .par_iter_mut()
+            .zip(level.par_iter_mut())
+            .zip(parent.par_iter_mut())
+            .zip(order.par_iter())
+            .for_each(|(((r, l), p), &t)| {
+                let t = t as usize;
+                (*r, *l, *p) = (self.region[t], self.level[t], self.parent[t]);
             });
-        }
+        drop(order);
         self.region = region;
         self.level = level;
         self.parent = parent;
@@ -223,9 +223,10 @@ impl TetMesh {
         self.required = remap_set(&self.required);
     }
 
-    /// The new id of each tet slot (`DEAD` for dead slots): live tets sorted
-    /// by their smallest new vertex id, ties in slot order — a stable counting
-    /// sort keyed by that vertex. `pmap` is old → new point id.
+    /// The new id of each tet slot (`DEAD` for dead slots) and its inverse:
+    /// live tets sorted by their smallest new vertex id, ties in slot order
+    /// (as the sort of compacted ids did) — a stable counting sort keyed by
+    /// that vertex. `pmap` is old → new point id; `map` is a buffer to reuse.
     fn tet_order(&self, pmap: &[u32], np: usize, mut map: Vec<u32>) -> TetOrder {
         // Key of each slot first, written where its new id will go.
         map.clear();
@@ -260,19 +261,27 @@ impl TetMesh {
                 at += n;
             }
         }
-        map.par_chunks_mut(per)
-            .zip(counts.par_iter_mut())
-            .for_each(|(part, fill)| {
-                for k in part.iter_mut().filter(|k| **k != DEAD) {
-                    let f = &mut fill[*k as usize];
-                    *k = *f;
-                    *f += 1;
-                }
-            });
-        TetOrder {
-            dead: map.len() - at as usize,
-            map,
+        let mut order = vec![0u32; at as usize];
+        {
+            let out = Disjoint::new(&mut order);
+            let out = &out;
+            map.par_chunks_mut(per)
+                .zip(counts.par_iter_mut())
+                .enumerate()
+                .for_each(|(i, (part, fill))| {
+                    for (t, k) in part.iter_mut().enumerate() {
+                        if *k != DEAD {
+                            let f = &mut fill[*k as usize];
+                            // SAFETY: fill[k] runs over this part's own
+                            // stretch of key k: one writer.
+                            unsafe { out.write(*f as usize, (i * per + t) as u32) };
+                            *k = *f;
+                            *f += 1;
+                        }
+                    }
+                });
         }
+        TetOrder { map, order }
     }
 }
 
@@ -280,8 +289,8 @@ impl TetMesh {
 struct TetOrder {
     /// New id of each old slot, `DEAD` for dead slots.
     map: Vec<u32>,
-    /// Number of dead slots.
-    dead: usize,
+    /// Old slot of each new id.
+    order: Vec<u32>,
 }
 
 /// The compaction's point map for these tet slots (old id → id among the
@@ -328,27 +337,8 @@ fn last_tets(tets: &[[u32; 4]], n: usize) -> Vec<u32> {
             }
         }
     });
+    // Reuses the allocation (same layout).
     last.into_iter().map(AtomicU32::into_inner).collect()
-}
-
-/// `out[map[t]] = f(&values[t])` for every slot `t` whose `map` is not
-/// `DEAD`; `map` is one-to-one onto `0..out.len()`.
-fn scatter<T: Sync, U: Copy + Send + Sync>(
-    out: &mut [U],
-    values: &[T],
-    map: &[u32],
-    f: impl Fn(&T) -> U + Sync,
-) {
-    let out = Disjoint::new(out);
-    let out = &out;
-    values
-        .par_iter()
-        .zip(map.par_iter())
-        .filter(|(_, &m)| m != DEAD)
-        .for_each(|(v, &m)| {
-            // SAFETY: `map` is one-to-one, so each element has one writer.
-            unsafe { out.write(m as usize, f(v)) }
-        });
 }
 
 #[cfg(test)]
