@@ -123,8 +123,7 @@ impl TetMesh {
         // The tet map lives in the generation array's allocation (all zeros
         // afterwards): no fresh pages.
         let generation = std::mem::take(&mut self.generation);
-        let tmap = self.tet_order(&pmap, np, generation);
-        let TetOrder { map: tmap, order } = tmap;
+        let TetOrder { map: tmap, order } = self.tet_order(&pmap, np, generation);
         let nt = order.len();
         // Gathered in the new order: the writes stream, and the reads of
         // spatial neighbours (their slots and tet map entries) stay close.
@@ -168,6 +167,7 @@ impl TetMesh {
         self.level = level;
         self.parent = parent;
         self.free.clear();
+        // The old table goes before the new one is built.
         self.v2t = Vec::new();
         self.v2t = last_tets(&self.tets, np);
         if want_maps {
