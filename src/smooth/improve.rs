@@ -17,11 +17,12 @@ use super::BallPoints;
 use crate::geom::{tet_min_sine, TET_EDGES};
 use crate::mesh::fasthash::{FastHashMap, FastHashSet};
 use crate::mesh::{edge_key, EdgeKey, TetMesh, NO_ADJ};
+use crate::ops::bulk::Disjoint;
 use crate::ops::edge_removal::{apply_ring_triangulation, RingTriangulation};
 use crate::ops::EdgeRing;
 use glam::DVec3;
 use rayon::prelude::*;
-use std::sync::atomic::{AtomicU8, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU8, Ordering};
 
 /// Options of [`improve`].
 #[derive(Clone, Debug)]
@@ -112,8 +113,10 @@ struct Tracker {
     tq: Vec<f64>,
     /// Tet slots touched since they were last examined for edge removal.
     tet_dirty: Vec<bool>,
-    /// Vertices whose ball changed since they were last examined.
-    vert_dirty: Vec<bool>,
+    /// Vertices whose ball changed since they were last examined (atomic:
+    /// the moves of a colour class are recorded in parallel, and two balls
+    /// of a class may share a vertex, which both flag).
+    vert_dirty: Vec<AtomicBool>,
     /// Tet slots whose edges may be removed.
     allowed: Option<Vec<bool>>,
 }
@@ -134,7 +137,10 @@ impl Tracker {
         Tracker {
             tq,
             tet_dirty: vec![true; mesh.n_tet_slots()],
-            vert_dirty: vec![true; mesh.n_points()],
+            vert_dirty: (0..mesh.n_points())
+                .into_par_iter()
+                .map(|_| AtomicBool::new(true))
+                .collect(),
             allowed,
         }
     }
@@ -154,7 +160,7 @@ impl Tracker {
         self.tq[t as usize] = q;
         self.tet_dirty[t as usize] = true;
         for v in mesh.tet(t) {
-            self.vert_dirty[v as usize] = true;
+            *self.vert_dirty[v as usize].get_mut() = true;
         }
     }
 
@@ -602,10 +608,11 @@ fn smooth_pass(
     let mut verts = Vec::new();
     let mut alone = Vec::new();
     for v in 0..mesh.n_points() {
-        if !tr.vert_dirty[v] || !movable[v] {
+        let dirty = tr.vert_dirty[v].get_mut();
+        if !*dirty || !movable[v] {
             continue;
         }
-        tr.vert_dirty[v] = false;
+        *dirty = false;
         if vq[v] < bar {
             verts.push(v as u32);
             alone.push(vq[v] < opts.threshold);
@@ -643,17 +650,21 @@ fn smooth_pass(
         drop(classes);
         for group in &groups {
             let moves = decide_moves(mesh, &tr.tq, &balls, block, group, opts, &mut scratch);
-            for (&i, m) in group.iter().zip(moves) {
-                let Some(m) = m else { continue };
-                apply_move(
-                    mesh,
-                    tr,
-                    balls.ball(i as usize),
-                    block[i as usize],
-                    m,
-                    report,
-                );
-                moved += 1;
+            if group.len() < 64 {
+                for (&i, m) in group.iter().zip(moves) {
+                    let Some(m) = m else { continue };
+                    apply_move(
+                        mesh,
+                        tr,
+                        balls.ball(i as usize),
+                        block[i as usize],
+                        m,
+                        report,
+                    );
+                    moved += 1;
+                }
+            } else {
+                moved += apply_moves(mesh, tr, &balls, block, group, moves, report);
             }
         }
     }
@@ -675,6 +686,53 @@ fn apply_move(
     }
     report.laplacian_moves += m.laplacian as usize;
     report.optimized_moves += m.optimized as usize;
+}
+
+/// [`apply_move`] for every move of `group`, a class of vertices no two of
+/// which share a tet, the balls' records made in parallel: each tet slot is
+/// in one ball only, so its quality and flag have one writer, and a vertex
+/// flagged from two balls is flagged either way. Same result as applying the
+/// moves one by one. Returns the number of moves.
+fn apply_moves(
+    mesh: &mut TetMesh,
+    tr: &mut Tracker,
+    balls: &Balls,
+    verts: &[u32],
+    group: &[u32],
+    moves: Vec<Option<VertexMove>>,
+    report: &mut ImproveReport,
+) -> usize {
+    let mut n = 0;
+    for (&i, m) in group.iter().zip(&moves) {
+        if let Some(m) = m {
+            mesh.set_point(verts[i as usize], m.x);
+            report.laplacian_moves += m.laplacian as usize;
+            report.optimized_moves += m.optimized as usize;
+            n += 1;
+        }
+    }
+    let mesh = &*mesh;
+    let tq = Disjoint::new(&mut tr.tq);
+    let tet_dirty = Disjoint::new(&mut tr.tet_dirty);
+    let vert_dirty = &tr.vert_dirty;
+    group
+        .par_iter()
+        .zip(moves.par_iter())
+        .with_min_len(32)
+        .for_each(|(&i, m)| {
+            let Some(m) = m else { return };
+            for (&t, &q) in balls.ball(i as usize).iter().zip(&m.qualities) {
+                // SAFETY: the balls of a class share no tet slot.
+                unsafe {
+                    tq.write(t as usize, q);
+                    tet_dirty.write(t as usize, true);
+                }
+                for v in mesh.tet(t) {
+                    vert_dirty[v as usize].store(true, Ordering::Relaxed);
+                }
+            }
+        });
+    n
 }
 
 /// The moves [`smooth_vertex`] decides for the vertices of balls `group`
