@@ -650,49 +650,18 @@ fn smooth_pass(
         drop(classes);
         for group in &groups {
             let moves = decide_moves(mesh, &tr.tq, &balls, block, group, opts, &mut scratch);
-            if group.len() < 64 {
-                for (&i, m) in group.iter().zip(moves) {
-                    let Some(m) = m else { continue };
-                    apply_move(
-                        mesh,
-                        tr,
-                        balls.ball(i as usize),
-                        block[i as usize],
-                        m,
-                        report,
-                    );
-                    moved += 1;
-                }
-            } else {
-                moved += apply_moves(mesh, tr, &balls, block, group, moves, report);
-            }
+            moved += apply_moves(mesh, tr, &balls, block, group, moves, report);
         }
     }
     moved
 }
 
-/// Moves `v` (ball `ball`) as `m` says and records the ball's new qualities.
-fn apply_move(
-    mesh: &mut TetMesh,
-    tr: &mut Tracker,
-    ball: &[u32],
-    v: u32,
-    m: VertexMove,
-    report: &mut ImproveReport,
-) {
-    mesh.set_point(v, m.x);
-    for (&t, &q) in ball.iter().zip(&m.qualities) {
-        tr.set(mesh, t, q);
-    }
-    report.laplacian_moves += m.laplacian as usize;
-    report.optimized_moves += m.optimized as usize;
-}
-
-/// [`apply_move`] for every move of `group`, a class of vertices no two of
-/// which share a tet, the balls' records made in parallel: each tet slot is
-/// in one ball only, so its quality and flag have one writer, and a vertex
-/// flagged from two balls is flagged either way. Same result as applying the
-/// moves one by one. Returns the number of moves.
+/// Moves the vertices of `group` (balls no two of which share a tet) as
+/// `moves` says and records their balls' new qualities; returns the number
+/// of moves. For a large group the records are made in parallel: each tet
+/// slot is in one ball only, so its quality and flag have one writer, and a
+/// vertex flagged from two balls is flagged either way, so the result is
+/// that of recording the moves one by one.
 fn apply_moves(
     mesh: &mut TetMesh,
     tr: &mut Tracker,
@@ -710,6 +679,16 @@ fn apply_moves(
             report.optimized_moves += m.optimized as usize;
             n += 1;
         }
+    }
+    if group.len() < 64 {
+        // Not worth a trip through the thread pool.
+        for (&i, m) in group.iter().zip(&moves) {
+            let Some(m) = m else { continue };
+            for (&t, &q) in balls.ball(i as usize).iter().zip(&m.qualities) {
+                tr.set(mesh, t, q);
+            }
+        }
+        return n;
     }
     let mesh = &*mesh;
     let tq = Disjoint::new(&mut tr.tq);

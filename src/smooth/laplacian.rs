@@ -1,18 +1,9 @@
 //! Laplacian smoothing: the vertex goes to the centroid of its neighbours
 //! (Field 1988), kept only if the worst tet of its ball improves.
 
-use super::{ball_min_mean_at, vertex_neighbours, BallPoints};
+use super::{ball_min_mean_at, BallPoints};
 use crate::mesh::TetMesh;
 use glam::DVec3;
-
-/// Centroid of the neighbours of `v`.
-pub fn laplacian_target(mesh: &TetMesh, v: u32, ball: &[u32], scratch: &mut Vec<u32>) -> DVec3 {
-    vertex_neighbours(mesh, v, ball, scratch);
-    if scratch.is_empty() {
-        return mesh.point(v);
-    }
-    scratch.iter().map(|&u| mesh.point(u)).sum::<DVec3>() / scratch.len() as f64
-}
 
 /// The ball of a vertex as it stands, for [`laplacian_position`].
 #[derive(Clone, Copy, Debug)]

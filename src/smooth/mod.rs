@@ -69,23 +69,6 @@ pub fn ball_stays_positive(mesh: &TetMesh, v: u32, ball: &[u32], x: DVec3) -> bo
     })
 }
 
-/// The distinct vertices adjacent to `v` (sharing a tet with it), appended to
-/// `out` (cleared first) in the order they first appear in `ball`.
-pub fn vertex_neighbours(mesh: &TetMesh, v: u32, ball: &[u32], out: &mut Vec<u32>) {
-    out.clear();
-    with_stamps(mesh.n_points(), v, |stamp, epoch| {
-        for &t in ball {
-            for x in mesh.tet(t) {
-                let s = &mut stamp[x as usize];
-                if *s != epoch {
-                    *s = epoch;
-                    out.push(x);
-                }
-            }
-        }
-    });
-}
-
 /// Runs `f` on this thread's "seen in this call" stamps, one per point of a
 /// mesh of `n_points` points, with a fresh epoch: a point is seen when its
 /// stamp equals the epoch, and only `v` is seen at the start. A ball has
@@ -141,9 +124,9 @@ impl BallPoints {
 
     /// The centroid of the distinct neighbours of `v` (the ball's vertex,
     /// in a mesh of `n_points` points), summed in the order they first
-    /// appear in the ball, as [`laplacian::laplacian_target`] sums them;
-    /// `None` for an empty ball. Reads only what [`BallPoints::load`]
-    /// loaded, so the ball is not walked a second time in the mesh.
+    /// appear in the ball: the Laplacian target. `None` for an empty ball.
+    /// Reads only what [`BallPoints::load`] loaded, so the ball is not walked
+    /// a second time in the mesh.
     pub fn neighbour_centroid(&self, n_points: usize, v: u32) -> Option<DVec3> {
         with_stamps(n_points, v, |stamp, epoch| {
             let mut sum = DVec3::ZERO;
