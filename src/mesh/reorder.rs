@@ -8,7 +8,7 @@
 
 use super::fasthash::{FastHashMap, FastHashSet};
 use super::{edge_key, face_key, Remap, TetMesh, DEAD, NO_ADJ};
-use crate::ops::bulk::Disjoint;
+use crate::ops::bulk::{Disjoint, LastTouch};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicU32, Ordering};
 
@@ -325,20 +325,15 @@ fn used_points(tets: &[[u32; 4]], n: usize) -> (Vec<u32>, usize) {
 
 /// The vertex → tet table of a compacted mesh as
 /// [`TetMesh::rebuild_v2t`] builds it: the last (highest) tet holding each
-/// point, found with an atomic maximum.
+/// point.
 fn last_tets(tets: &[[u32; 4]], n: usize) -> Vec<u32> {
-    let last: Vec<AtomicU32> = (0..n).into_par_iter().map(|_| AtomicU32::new(0)).collect();
-    // Descending, so that most points already hold a later tet.
+    let last = LastTouch::new(n);
     tets.par_iter().enumerate().rev().for_each(|(t, v)| {
         for &x in v {
-            let a = &last[x as usize];
-            if a.load(Ordering::Relaxed) < t as u32 {
-                a.fetch_max(t as u32, Ordering::Relaxed);
-            }
+            last.touch(x, t);
         }
     });
-    // Reuses the allocation (same layout).
-    last.into_iter().map(AtomicU32::into_inner).collect()
+    last.into_last(DEAD)
 }
 
 #[cfg(test)]

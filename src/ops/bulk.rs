@@ -112,4 +112,13 @@ impl LastTouch {
     pub(crate) fn get(&self, x: usize) -> Option<usize> {
         (self.0[x].load(Ordering::Relaxed) as usize).checked_sub(1)
     }
+
+    /// Per point, the last operation that touched it, `none` where none
+    /// did. Consumes the table and reuses its memory.
+    pub(crate) fn into_last(self, none: u32) -> Vec<u32> {
+        self.0
+            .into_iter()
+            .map(|a| a.into_inner().checked_sub(1).unwrap_or(none))
+            .collect()
+    }
 }
