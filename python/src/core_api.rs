@@ -1,0 +1,508 @@
+//! # CORE API — the one place the Python package touches the `tetrefine` crate.
+//!
+//! Every `tetrefine::…` path used by the bindings is in this file (and
+//! nowhere else in `python/src`), so that a change of the core's public API
+//! (module renames, a curated `lib.rs`) is adapted here alone. The functions
+//! take and return plain Rust data (vectors, strings of JSON, messages) and
+//! know nothing of Python; `lib.rs` does the Python side.
+//!
+//! What each function does follows the CLI (`src/cli/*.rs`) step by step, so
+//! that the package behaves as the command line does.
+
+use std::path::Path;
+
+use tetrefine::io::vtk::CellArray;
+use tetrefine::mesh::MeshData;
+use tetrefine::refine::marking::{select, MarkStrategy};
+use tetrefine::refine::step::descendants_of_last_step;
+use tetrefine::refine::{locate_parents, refine_step_with_progress, Phase, Progress, RefineOptions};
+use tetrefine::report::stats::DEFAULT_HIST_MAX_DEG;
+use tetrefine::report::Histogram;
+use tetrefine::MeshStats;
+
+/// The core's mesh store.
+pub type TetMesh = tetrefine::TetMesh;
+
+/// Default number of histogram bins of `quality --json` (1° bins over 0–71°).
+pub const DEFAULT_BINS: usize = tetrefine::report::stats::DEFAULT_BINS;
+
+/// A mesh as plain arrays, 0-based, before validation.
+#[derive(Default)]
+pub struct Input {
+    /// Vertex coordinates.
+    pub points: Vec<[f64; 3]>,
+    /// Four vertex ids per tet (any orientation).
+    pub tets: Vec<[u32; 4]>,
+    /// Region per tet (empty: all 0).
+    pub regions: Vec<i32>,
+    /// Marked triangles with their marker.
+    pub faces: Vec<([u32; 3], i32)>,
+    /// Feature edges with their marker.
+    pub edges: Vec<([u32; 2], i32)>,
+    /// Corner vertices.
+    pub corners: Vec<u32>,
+}
+
+/// What building changed (the notes the CLI prints on stderr).
+#[derive(Clone, Debug, Default)]
+pub struct BuildNotes {
+    /// Negatively oriented tets turned around.
+    pub reoriented: usize,
+    /// Points no tet uses.
+    pub unreferenced_points: usize,
+    /// Marked triangles that are no face of any tet (dropped).
+    pub dropped_triangles: usize,
+    /// Tagged edges that are no edge of any tet (dropped).
+    pub dropped_edges: usize,
+}
+
+fn notes(r: &tetrefine::mesh::BuildReport) -> BuildNotes {
+    BuildNotes {
+        reoriented: r.reoriented,
+        unreferenced_points: r.unreferenced_points,
+        dropped_triangles: r.dropped_triangles,
+        dropped_edges: r.dropped_edges,
+    }
+}
+
+/// Why arrays could not be built into a mesh: the library's message, and the
+/// 1-based tet it names, if any.
+pub struct BuildFailure {
+    /// The library's message (the same as the file readers give).
+    pub message: String,
+    /// 1-based tet number the message refers to.
+    pub tet: Option<usize>,
+}
+
+/// Builds the store from arrays through the library's own path
+/// (`TetMesh::from_data`, as every file reader does), then compacts it so
+/// that slot `i` is the `i`-th tet.
+pub fn build(input: Input) -> Result<(TetMesh, BuildNotes), BuildFailure> {
+    use tetrefine::mesh::MeshError as E;
+    let data = MeshData {
+        points: input.points,
+        tets: input.tets,
+        tet_regions: input.regions,
+        triangles: input.faces,
+        edges: input.edges,
+        corners: input.corners,
+        ..Default::default()
+    };
+    match TetMesh::from_data(&data) {
+        Ok((mut mesh, report)) => {
+            drop(data);
+            mesh.compact();
+            Ok((mesh, notes(&report)))
+        }
+        Err(e) => {
+            let tet = match &e {
+                E::IndexOutOfRange { at, .. }
+                | E::RepeatedVertex { at, .. }
+                | E::ZeroVolume { at }
+                | E::DuplicateTet { at, .. }
+                | E::NonManifoldFace { at, .. }
+                | E::Overlap { at, .. } => Some(at.tet),
+                _ => None,
+            };
+            Err(BuildFailure {
+                message: e.to_string(),
+                tet,
+            })
+        }
+    }
+}
+
+/// Reads a mesh file (format by extension, as the CLI) and compacts it.
+pub fn read(path: &Path) -> Result<(TetMesh, BuildNotes), String> {
+    let (mut mesh, report) = tetrefine::io::load_mesh(path).map_err(|e| e.to_string())?;
+    mesh.compact();
+    Ok((mesh, notes(&report)))
+}
+
+/// Refuses an output extension the writers do not know, before any work.
+pub fn check_output_path(path: &Path) -> Result<(), String> {
+    tetrefine::io::Format::for_writing(path)
+        .map(|_| ())
+        .map_err(|e| e.to_string())
+}
+
+/// Writes a (compact) mesh; a `.vtu` also carries `level`, `parent` and
+/// `marked` cell arrays, as `tetrefine refine` writes them.
+pub fn write(path: &Path, mesh: &TetMesh, marked: Option<&[bool]>) -> Result<(), String> {
+    check_output_path(path)?;
+    let is_vtu = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("vtu"));
+    if is_vtu {
+        let n = mesh.n_tets();
+        let level = |i: usize| i32::from(mesh.level(i as u32));
+        let parent = |i: usize| mesh.parent(i as u32) as i32;
+        let mark = |i: usize| i32::from(marked.is_some_and(|m| m[i]));
+        let cells = [
+            CellArray::Int32With("level".into(), n, &level),
+            CellArray::Int32With("parent".into(), n, &parent),
+            CellArray::Int32With("marked".into(), n, &mark),
+        ];
+        tetrefine::io::vtk::write_vtu(path, mesh, &cells).map_err(|e| e.to_string())
+    } else {
+        tetrefine::io::write_mesh(path, mesh).map_err(|e| e.to_string())
+    }
+}
+
+const _: () = assert!(std::mem::size_of::<glam::DVec3>() == 3 * std::mem::size_of::<f64>());
+
+/// The points of the store as `[x, y, z]` rows, borrowed (no copy).
+pub fn points(mesh: &TetMesh) -> &[[f64; 3]] {
+    let p = mesh.points();
+    // SAFETY: glam's `DVec3` is `#[repr(C)] { x, y, z: f64 }` (size checked
+    // above), so a slice of them is a slice of `[f64; 3]`.
+    unsafe { std::slice::from_raw_parts(p.as_ptr().cast::<[f64; 3]>(), p.len()) }
+}
+
+/// The tets of a compact store, borrowed (no copy; slot `i` is tet `i`).
+pub fn tets(mesh: &TetMesh) -> &[[u32; 4]] {
+    debug_assert_eq!(mesh.n_tet_slots(), mesh.n_tets());
+    mesh.tet_slots()
+}
+
+/// Number of tets.
+pub fn n_tets(mesh: &TetMesh) -> usize {
+    mesh.n_tets()
+}
+
+/// Number of points.
+pub fn n_points(mesh: &TetMesh) -> usize {
+    mesh.n_points()
+}
+
+/// Region per tet.
+pub fn regions(mesh: &TetMesh) -> Vec<i32> {
+    mesh.tet_ids().map(|t| mesh.region(t)).collect()
+}
+
+/// Refinement level per tet (0 for input tets).
+pub fn levels(mesh: &TetMesh) -> Vec<u8> {
+    mesh.tet_ids().map(|t| mesh.level(t)).collect()
+}
+
+/// Parent per tet: the input tet holding its centroid after `refine`.
+pub fn parents(mesh: &TetMesh) -> Vec<u32> {
+    mesh.tet_ids().map(|t| mesh.parent(t)).collect()
+}
+
+/// Marked triangles (sorted vertex triples, in sorted order) and markers.
+pub fn marked_faces(mesh: &TetMesh) -> Vec<([u32; 3], i32)> {
+    let mut v: Vec<([u32; 3], i32)> = mesh.face_markers().iter().map(|(k, &m)| (*k, m)).collect();
+    v.sort_unstable();
+    v
+}
+
+/// Feature edges (sorted pairs, in sorted order) and markers.
+pub fn feature_edges(mesh: &TetMesh) -> Vec<([u32; 2], i32)> {
+    let mut v: Vec<([u32; 2], i32)> = mesh
+        .feature_edges()
+        .iter()
+        .map(|(k, &m)| (*k, m))
+        .collect();
+    v.sort_unstable();
+    v
+}
+
+/// Corner vertices, sorted.
+pub fn corners(mesh: &TetMesh) -> Vec<u32> {
+    let mut v: Vec<u32> = mesh.corners().iter().copied().collect();
+    v.sort_unstable();
+    v
+}
+
+/// `quality --json` of the mesh with `bins` histogram bins over 0–71°.
+pub fn quality_json(mesh: &TetMesh, bins: usize) -> String {
+    let stats = MeshStats::compute_with(mesh, Histogram::new(0.0, DEFAULT_HIST_MAX_DEG, bins));
+    serde_json::to_string(&stats).unwrap_or_else(|e| format!("{{\"error\":\"{e}\"}}"))
+}
+
+/// Per tet: minimum and maximum dihedral angle (degrees), the paper's
+/// quality (min sine of the signed dihedral angles) and the signed volume —
+/// the cell arrays of the `.vtu` writer.
+pub fn tet_quality(mesh: &TetMesh) -> [Vec<f64>; 4] {
+    use rayon::prelude::*;
+    use tetrefine::geom::quality::{tet_quality, tet_volume};
+    let per: Vec<[f64; 4]> = (0..mesh.n_tets() as u32)
+        .into_par_iter()
+        .map(|t| {
+            let p = mesh.tet_points(t);
+            let q = tet_quality(&p);
+            [
+                q.min_dihedral_deg,
+                q.max_dihedral_deg,
+                q.min_sine,
+                tet_volume(&p),
+            ]
+        })
+        .collect();
+    [0, 1, 2, 3].map(|k| per.iter().map(|q| q[k]).collect())
+}
+
+/// Options of [`refine`], the flags of `tetrefine refine`.
+pub struct RefineArgs {
+    /// `--steps`.
+    pub steps: usize,
+    /// `--boundary`.
+    pub boundary: String,
+    /// `--opt-passes`.
+    pub opt_passes: usize,
+    /// `--threshold`.
+    pub threshold: f64,
+    /// `--stop-after`.
+    pub stop_after: Option<String>,
+    /// `--features auto|none|FILE`.
+    pub features: String,
+    /// `--feature-angle`.
+    pub feature_angle: f64,
+    /// The `--mark` specs (already joined with the geometric selections).
+    pub marks: Vec<String>,
+    /// `--smooth refined` (true) or `all`.
+    pub smooth_refined: bool,
+    /// `--step-offset`.
+    pub step_offset: usize,
+    /// Also compute `quality --json` after every step.
+    pub stats: bool,
+}
+
+/// What went wrong in [`refine`]: bad options (a `ValueError`) or a file.
+pub enum RefineError {
+    /// An option or the indicator is invalid.
+    Value(String),
+    /// A feature-edge file could not be read.
+    File(String),
+}
+
+/// The result of [`refine`].
+pub struct Refined {
+    /// The refined mesh, compact, with `parent` located in the input.
+    pub mesh: TetMesh,
+    /// Per output tet: does it descend from a selected input tet?
+    pub marked: Vec<bool>,
+    /// Per step: the step report as JSON (phases, counts, seconds), with the
+    /// `quality --json` fields when asked for.
+    pub steps: Vec<String>,
+}
+
+/// Called at the start of every phase with (1-based step, phase name, live
+/// tets). It may unwind (`std::panic::resume_unwind`) to cancel the run.
+pub type PhaseHook<'a> = dyn Fn(usize, &str, u64) + Sync + 'a;
+
+struct HookProgress<'a> {
+    hook: &'a PhaseHook<'a>,
+    step: std::sync::atomic::AtomicUsize,
+}
+
+impl Progress for HookProgress<'_> {
+    fn phase_start(&self, phase: Phase, total: u64) {
+        let step = self.step.load(std::sync::atomic::Ordering::Relaxed);
+        (self.hook)(step, phase.name(), total);
+    }
+}
+
+/// The union of the marking specs, or `None` for uniform refinement (the
+/// CLI's `mark_strategy`, with the Python argument names).
+fn strategy(marks: &[String], have_indicator: bool) -> Result<Option<MarkStrategy>, String> {
+    if marks.is_empty() {
+        return Ok(None);
+    }
+    let parts = marks
+        .iter()
+        .map(|s| {
+            s.parse::<MarkStrategy>()
+                .map_err(|e| format!("mark={s:?}: {e}"))
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    let st = MarkStrategy::union(parts);
+    if st.needs_indicator() && !have_indicator {
+        return Err(format!("mark {st} needs an indicator array (indicator=...)"));
+    }
+    Ok(Some(st))
+}
+
+/// `tetrefine refine` on a copy of `input`: the same validation, marking,
+/// feature handling, steps, parent location and compaction as the CLI.
+pub fn refine(
+    input: &TetMesh,
+    a: &RefineArgs,
+    indicator: Option<&[f64]>,
+    hook: &PhaseHook<'_>,
+) -> Result<Refined, RefineError> {
+    use RefineError::{File, Value};
+    let boundary = a.boundary.parse().map_err(|e| Value(format!("boundary: {e}")))?;
+    let stop_after = match &a.stop_after {
+        Some(p) => Some(p.parse::<Phase>().map_err(|e| Value(format!("stop_after: {e}")))?),
+        None => None,
+    };
+    if !(a.threshold > 0.0 && a.threshold < 1.0) {
+        return Err(Value(format!(
+            "threshold={} must lie in (0, 1) (a sine)",
+            a.threshold
+        )));
+    }
+    if !(a.feature_angle > 0.0 && a.feature_angle < 180.0) {
+        return Err(Value(format!(
+            "feature_angle={} must lie in (0, 180) degrees",
+            a.feature_angle
+        )));
+    }
+    let st = strategy(&a.marks, indicator.is_some()).map_err(Value)?;
+    let selection = match &st {
+        Some(st) => Some(select(st, indicator, input).map_err(|e| Value(format!("mark {st}: {e}")))?),
+        None => None,
+    };
+    // One copy: the input stays as it is (the Python object is immutable)
+    // and serves to locate the parents afterwards.
+    let mut mesh = input.clone();
+    {
+        use tetrefine::refine::features::{detect_features, read_edge_list};
+        match a.features.as_str() {
+            "none" => mesh.clear_features(),
+            "auto" => {
+                detect_features(&mut mesh, a.feature_angle);
+            }
+            file => {
+                read_edge_list(&mut mesh, Path::new(file)).map_err(|e| File(e.to_string()))?;
+            }
+        }
+    }
+    let mut opts = RefineOptions {
+        boundary,
+        opt_passes: a.opt_passes,
+        threshold: a.threshold,
+        stop_after,
+        selection: selection.clone(),
+        smooth_refined_only: selection.is_some() && a.smooth_refined,
+        step_offset: a.step_offset,
+        check_each_phase: false,
+    };
+    let progress = HookProgress {
+        hook,
+        step: std::sync::atomic::AtomicUsize::new(0),
+    };
+    let mut steps = Vec::with_capacity(a.steps);
+    for s in 1..=a.steps {
+        progress.step.store(s, std::sync::atomic::Ordering::Relaxed);
+        if s > 1 && opts.selection.is_some() {
+            opts.selection = Some(descendants_of_last_step(&mesh, s - 1));
+        }
+        let report = refine_step_with_progress(&mut mesh, s, &opts, &progress);
+        let mut value = serde_json::to_value(&report).unwrap_or_default();
+        if a.stats {
+            let stats = serde_json::to_value(MeshStats::compute(&mesh)).unwrap_or_default();
+            if let (Some(obj), serde_json::Value::Object(q)) = (value.as_object_mut(), stats) {
+                obj.insert("quality".into(), serde_json::Value::Object(q));
+            }
+        }
+        steps.push(value.to_string());
+    }
+    locate_parents(input, &mut mesh);
+    mesh.compact();
+    let sel = selection.as_deref();
+    let marked = mesh
+        .tet_ids()
+        .map(|t| {
+            let p = mesh.parent(t) as usize;
+            sel.is_none_or(|s| s.get(p).copied().unwrap_or(false))
+        })
+        .collect();
+    Ok(Refined {
+        mesh,
+        marked,
+        steps,
+    })
+}
+
+/// `tetrefine improve`: edge removal and smoothing, boundary fixed, on a
+/// copy; the report as JSON.
+pub fn improve(input: &TetMesh, passes: usize, threshold: f64) -> Result<(TetMesh, String), String> {
+    use tetrefine::smooth::{improve, ImproveOptions};
+    if !(threshold > 0.0 && threshold < 1.0) {
+        return Err(format!("threshold={threshold} must lie in (0, 1) (a sine)"));
+    }
+    let mut mesh = input.clone();
+    let report = improve(
+        &mut mesh,
+        &ImproveOptions {
+            passes,
+            threshold,
+            ..Default::default()
+        },
+    );
+    mesh.compact();
+    Ok((mesh, serde_json::to_string(&report).unwrap_or_default()))
+}
+
+/// `tetrefine bisect`: `steps` uniform 1:8 red refinements; per step a JSON
+/// `{"tets", "points", "seconds"}`.
+pub fn bisect(input: &TetMesh, steps: usize) -> Result<(TetMesh, Vec<String>), String> {
+    let mut mesh = input.clone();
+    let mut reports = Vec::new();
+    for s in 1..=steps {
+        let t0 = std::time::Instant::now();
+        mesh = tetrefine::refine::bisect::bisect(&mesh).map_err(|e| format!("step {s}: {e}"))?;
+        mesh.compact();
+        reports.push(
+            serde_json::json!({
+                "tets": mesh.n_tets(),
+                "points": mesh.n_points(),
+                "seconds": t0.elapsed().as_secs_f64(),
+            })
+            .to_string(),
+        );
+    }
+    Ok((mesh, reports))
+}
+
+/// The surface TetGen fills: a file, or points and triangles.
+#[cfg(feature = "tetgen")]
+pub enum Surface<'a> {
+    /// A `.poly`, `.smesh`, `.off`, `.stl` or triangles-only `.mesh` file.
+    File(&'a Path),
+    /// Points and triangles with facet markers.
+    Triangles(Vec<[f64; 3]>, Vec<([u32; 3], i32)>),
+}
+
+/// Options of [`mesh_surface`] (the flags of `tetrefine mesh`).
+#[cfg(feature = "tetgen")]
+pub struct MeshArgs {
+    /// `--min-ratio`.
+    pub min_ratio: Option<f64>,
+    /// `--min-dihedral`.
+    pub min_dihedral: Option<f64>,
+    /// `--max-volume`.
+    pub max_volume: Option<f64>,
+    /// `--switches`.
+    pub switches: Option<String>,
+}
+
+/// `tetrefine mesh`: fills a closed surface with TetGen. Errors: `Ok(Err)` is
+/// a file error, `Err` any other.
+#[cfg(feature = "tetgen")]
+pub fn mesh_surface(surface: Surface<'_>, a: MeshArgs) -> Result<Result<TetMesh, String>, String> {
+    use tetrefine::io::plc::Plc;
+    use tetrefine::tetgen::{switches, tetrahedralize, Options};
+    let opts = Options {
+        min_ratio: a.min_ratio,
+        min_dihedral: a.min_dihedral,
+        max_volume: a.max_volume,
+        switches: a.switches,
+        size_field: None,
+    };
+    switches(&opts, false, "").map_err(|e| e.to_string())?;
+    let plc = match surface {
+        Surface::File(p) => match Plc::read(p) {
+            Ok(plc) => plc,
+            Err(e) => return Ok(Err(e.to_string())),
+        },
+        Surface::Triangles(points, tris) => Plc::from_triangles(points, &tris),
+    };
+    let mut mesh = tetrahedralize(&plc, &opts).map_err(|e| e.to_string())?;
+    mesh.compact();
+    Ok(Ok(mesh))
+}
