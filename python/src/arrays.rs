@@ -159,9 +159,7 @@ pub fn points(obj: &Bound<'_, PyAny>) -> PyResult<Vec<[f64; 3]>> {
             .call_method1("astype", ("float64",))?
             .cast_into::<PyUntypedArray>()?;
     }
-    fn copy<T: numpy::Element + Copy + Into<f64>>(
-        arr: &Bound<'_, PyArray2<T>>,
-    ) -> Vec<[f64; 3]> {
+    fn copy<T: numpy::Element + Copy + Into<f64>>(arr: &Bound<'_, PyArray2<T>>) -> Vec<[f64; 3]> {
         let ro = arr.readonly();
         let view = ro.as_array();
         view.rows()

@@ -15,7 +15,9 @@ use tetrefine::io::vtk::CellArray;
 use tetrefine::mesh::MeshData;
 use tetrefine::refine::marking::{select, MarkStrategy};
 use tetrefine::refine::step::descendants_of_last_step;
-use tetrefine::refine::{locate_parents, refine_step_with_progress, Phase, Progress, RefineOptions};
+use tetrefine::refine::{
+    locate_parents, refine_step_with_progress, Phase, Progress, RefineOptions,
+};
 use tetrefine::report::stats::DEFAULT_HIST_MAX_DEG;
 use tetrefine::report::Histogram;
 use tetrefine::MeshStats;
@@ -200,11 +202,7 @@ pub fn marked_faces(mesh: &TetMesh) -> Vec<([u32; 3], i32)> {
 
 /// Feature edges (sorted pairs, in sorted order) and markers.
 pub fn feature_edges(mesh: &TetMesh) -> Vec<([u32; 2], i32)> {
-    let mut v: Vec<([u32; 2], i32)> = mesh
-        .feature_edges()
-        .iter()
-        .map(|(k, &m)| (*k, m))
-        .collect();
+    let mut v: Vec<([u32; 2], i32)> = mesh.feature_edges().iter().map(|(k, &m)| (*k, m)).collect();
     v.sort_unstable();
     v
 }
@@ -320,7 +318,9 @@ fn strategy(marks: &[String], have_indicator: bool) -> Result<Option<MarkStrateg
         .collect::<Result<Vec<_>, _>>()?;
     let st = MarkStrategy::union(parts);
     if st.needs_indicator() && !have_indicator {
-        return Err(format!("mark {st} needs an indicator array (indicator=...)"));
+        return Err(format!(
+            "mark {st} needs an indicator array (indicator=...)"
+        ));
     }
     Ok(Some(st))
 }
@@ -334,9 +334,15 @@ pub fn refine(
     hook: &PhaseHook<'_>,
 ) -> Result<Refined, RefineError> {
     use RefineError::{File, Value};
-    let boundary = a.boundary.parse().map_err(|e| Value(format!("boundary: {e}")))?;
+    let boundary = a
+        .boundary
+        .parse()
+        .map_err(|e| Value(format!("boundary: {e}")))?;
     let stop_after = match &a.stop_after {
-        Some(p) => Some(p.parse::<Phase>().map_err(|e| Value(format!("stop_after: {e}")))?),
+        Some(p) => Some(
+            p.parse::<Phase>()
+                .map_err(|e| Value(format!("stop_after: {e}")))?,
+        ),
         None => None,
     };
     if !(a.threshold > 0.0 && a.threshold < 1.0) {
@@ -353,7 +359,9 @@ pub fn refine(
     }
     let st = strategy(&a.marks, indicator.is_some()).map_err(Value)?;
     let selection = match &st {
-        Some(st) => Some(select(st, indicator, input).map_err(|e| Value(format!("mark {st}: {e}")))?),
+        Some(st) => {
+            Some(select(st, indicator, input).map_err(|e| Value(format!("mark {st}: {e}")))?)
+        }
         None => None,
     };
     // One copy: the input stays as it is (the Python object is immutable)
@@ -420,7 +428,11 @@ pub fn refine(
 
 /// `tetrefine improve`: edge removal and smoothing, boundary fixed, on a
 /// copy; the report as JSON.
-pub fn improve(input: &TetMesh, passes: usize, threshold: f64) -> Result<(TetMesh, String), String> {
+pub fn improve(
+    input: &TetMesh,
+    passes: usize,
+    threshold: f64,
+) -> Result<(TetMesh, String), String> {
     use tetrefine::smooth::{improve, ImproveOptions};
     if !(threshold > 0.0 && threshold < 1.0) {
         return Err(format!("threshold={threshold} must lie in (0, 1) (a sine)"));

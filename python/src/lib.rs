@@ -331,7 +331,12 @@ impl Mesh {
     #[getter]
     fn boundary_markers<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<i32>>> {
         let f = core_api::marked_faces(&self.inner);
-        readonly(f.iter().map(|(_, m)| *m).collect::<Vec<_>>().into_pyarray(py))
+        readonly(
+            f.iter()
+                .map(|(_, m)| *m)
+                .collect::<Vec<_>>()
+                .into_pyarray(py),
+        )
     }
 
     /// (e, 2) uint32: the feature (crease) edges, sorted pairs in sorted
@@ -394,7 +399,7 @@ impl Mesh {
     ///
     /// bins: number of equal histogram bins of the per-tet minimum dihedral
     /// angle over 0-71 degrees (71: bins of 1 degree; at most 10000).
-    #[pyo3(signature = (bins=core_api::DEFAULT_BINS))]
+    #[pyo3(signature = (bins=core_api::DEFAULT_BINS), text_signature = "(self, bins=71)")]
     fn quality<'py>(&self, py: Python<'py>, bins: usize) -> PyResult<Bound<'py, PyAny>> {
         if bins == 0 || bins > 10_000 {
             return Err(PyValueError::new_err(format!(
@@ -649,8 +654,8 @@ impl Mesh {
     #[pyo3(signature = (steps=1))]
     fn bisect(&self, py: Python<'_>, steps: usize) -> PyResult<Mesh> {
         let mesh = &self.inner;
-        let (m, reports) = run_core(py, None, || core_api::bisect(mesh, steps))?
-            .map_err(PyValueError::new_err)?;
+        let (m, reports) =
+            run_core(py, None, || core_api::bisect(mesh, steps))?.map_err(PyValueError::new_err)?;
         Ok(Mesh {
             inner: m,
             marked: None,
@@ -666,8 +671,9 @@ impl Mesh {
     /// quality, volume (and medit:ref, gmsh:physical, gmsh:geometrical =
     /// region, so meshio's Medit and Gmsh writers keep the regions); with
     /// faces=True also a "triangle" block of the marked faces, whose
-    /// region/medit:ref/gmsh:* hold the markers (the other arrays are -1 or
-    /// NaN there).
+    /// region/medit:ref/gmsh:* hold the markers, and a "line" block of the
+    /// feature edges (the other arrays are -1 or NaN there). Corners have
+    /// no meshio cell type and are not carried.
     #[pyo3(signature = (faces=true))]
     fn to_meshio<'py>(slf: &Bound<'py, Self>, faces: bool) -> PyResult<Bound<'py, PyAny>> {
         let py = slf.py();
@@ -729,7 +735,9 @@ fn read(py: Python<'_>, path: PathBuf) -> PyResult<Mesh> {
 /// tests can check that a panic becomes a RuntimeError (never an abort).
 #[pyfunction]
 fn _panic_for_tests(py: Python<'_>) -> PyResult<()> {
-    run_core(py, None, || -> () { panic!("deliberate panic for the tests") })
+    run_core(py, None, || -> () {
+        panic!("deliberate panic for the tests")
+    })
 }
 
 /// mesh_surface(surface, *, min_ratio=None, min_dihedral=None,
@@ -776,7 +784,9 @@ fn mesh_surface(
         })?
     } else {
         let t = surface.cast::<pyo3::types::PyTuple>().map_err(|_| {
-            PyValueError::new_err("surface must be a path or a tuple (points, triangles[, markers])")
+            PyValueError::new_err(
+                "surface must be a path or a tuple (points, triangles[, markers])",
+            )
         })?;
         if t.len() < 2 || t.len() > 3 {
             return Err(PyValueError::new_err(

@@ -75,4 +75,10 @@ def cube_grid(n, h=1.0):
             p[axis] = 1
             verts.append(corner[tuple(p)])
         tets.append(np.stack(verts, axis=1))
-    return points, np.concatenate(tets)
+    tets = np.concatenate(tets)
+    # Odd paths give negatively oriented tets: swap two vertices so that every
+    # det[p1-p0, p2-p0, p3-p0] is positive (the library's orientation).
+    q = points[tets]
+    det = np.einsum("ij,ij->i", q[:, 1] - q[:, 0], np.cross(q[:, 2] - q[:, 0], q[:, 3] - q[:, 0]))
+    tets[det < 0] = tets[det < 0][:, [1, 0, 2, 3]]
+    return points, tets

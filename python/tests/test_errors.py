@@ -102,7 +102,7 @@ def test_bad_options():
         (dict(mark="fraction:0.1"), "needs an indicator array"),
         (dict(indicator=eta, mark="fraction:2"), "fraction:F needs F in \\(0,1\\], found 2"),
         (dict(indicator=eta, mark="bogus:1"), "mark=\"bogus:1\""),
-        (dict(box=[0, 0, 0]), "box needs 6 comma-separated numbers, found 3"),
+        (dict(box=[0, 0, 0]), "box:x0,y0,z0,x1,y1,z1 needs 6 comma-separated numbers, found 3"),
         (dict(sphere=[0, 0, 0, -1]), "sphere"),
         (dict(boundary="cubic"), "unknown boundary rule 'cubic'"),
         (dict(stop_after="later"), "unknown phase 'later'"),

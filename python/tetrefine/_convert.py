@@ -91,17 +91,22 @@ def to_meshio(mesh, faces=True):
     data = {k: [v] for k, v in arrays.items()}
     for k in ("medit:ref", "gmsh:physical", "gmsh:geometrical"):
         data[k] = [arrays["region"]]
-    tri = np.asarray(mesh.boundary_faces, dtype=np.int64)
-    if faces and len(tri):
-        cells.append(("triangle", tri))
-        markers = np.asarray(mesh.boundary_markers, dtype=np.int32)
-        for k, v in data.items():
-            if k in ("region", "medit:ref", "gmsh:physical", "gmsh:geometrical"):
-                v.append(markers)
-            elif v[0].dtype.kind == "f":
-                v.append(np.full(len(tri), np.nan))
-            else:
-                v.append(np.full(len(tri), -1, dtype=v[0].dtype))
+    if faces:
+        blocks = [
+            ("triangle", mesh.boundary_faces, mesh.boundary_markers),
+            ("line", mesh.feature_edges, np.zeros(len(mesh.feature_edges), dtype=np.int32)),
+        ]
+        for kind, ids, markers in blocks:
+            if not len(ids):
+                continue
+            cells.append((kind, np.asarray(ids, dtype=np.int64)))
+            for k, v in data.items():
+                if k in ("region", "medit:ref", "gmsh:physical", "gmsh:geometrical"):
+                    v.append(np.asarray(markers, dtype=np.int32))
+                elif v[0].dtype.kind == "f":
+                    v.append(np.full(len(ids), np.nan))
+                else:
+                    v.append(np.full(len(ids), -1, dtype=v[0].dtype))
     return meshio.Mesh(np.array(mesh.points), cells, cell_data=data)
 
 
