@@ -48,12 +48,16 @@ for r in range(runs):
     t2 = time.perf_counter()
     out_points, out_tets = np.array(fine.points), np.array(fine.tets)
     t3 = time.perf_counter()
+    parent = fine.parent  # located on first use (the CLI does it after the step)
+    t4 = time.perf_counter()
     step = fine.reports[0]["seconds"]
     refine_call = t2 - t1
     print(
         f"run {r + 1}: {fine.n_tets:,} tets out | CLI step {cli_step:.3f} s | "
         f"Python: Mesh() {t1 - t0:.3f} s, refine() {refine_call:.3f} s "
-        f"(its step {step:.3f} s, rest {refine_call - step:.3f} s), arrays out {t3 - t2:.3f} s | "
-        f"refine() / CLI step = {refine_call / cli_step:.3f}"
+        f"(its step {step:.3f} s, rest {refine_call - step:.3f} s), arrays out {t3 - t2:.3f} s, "
+        f"parents {t4 - t3:.3f} s | refine() / CLI step = {refine_call / cli_step:.3f}, "
+        f"refine() / own step = {refine_call / step:.3f}",
+        flush=True,
     )
-    del mesh, fine, out_points, out_tets
+    del mesh, fine, out_points, out_tets, parent

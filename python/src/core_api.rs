@@ -15,9 +15,7 @@ use tetrefine::io::vtk::CellArray;
 use tetrefine::mesh::MeshData;
 use tetrefine::refine::marking::{select, MarkStrategy};
 use tetrefine::refine::step::descendants_of_last_step;
-use tetrefine::refine::{
-    locate_parents, refine_step_with_progress, Phase, Progress, RefineOptions,
-};
+use tetrefine::refine::{refine_step_with_progress, Phase, Progress, RefineOptions};
 use tetrefine::report::stats::DEFAULT_HIST_MAX_DEG;
 use tetrefine::report::Histogram;
 use tetrefine::MeshStats;
@@ -129,8 +127,14 @@ pub fn check_output_path(path: &Path) -> Result<(), String> {
 }
 
 /// Writes a (compact) mesh; a `.vtu` also carries `level`, `parent` and
-/// `marked` cell arrays, as `tetrefine refine` writes them.
-pub fn write(path: &Path, mesh: &TetMesh, marked: Option<&[bool]>) -> Result<(), String> {
+/// `marked` cell arrays, as `tetrefine refine` writes them (`parents`
+/// replaces the store's own values when given).
+pub fn write(
+    path: &Path,
+    mesh: &TetMesh,
+    parents: Option<&[u32]>,
+    marked: Option<&[bool]>,
+) -> Result<(), String> {
     check_output_path(path)?;
     let is_vtu = path
         .extension()
@@ -139,7 +143,10 @@ pub fn write(path: &Path, mesh: &TetMesh, marked: Option<&[bool]>) -> Result<(),
     if is_vtu {
         let n = mesh.n_tets();
         let level = |i: usize| i32::from(mesh.level(i as u32));
-        let parent = |i: usize| mesh.parent(i as u32) as i32;
+        let parent = |i: usize| match parents {
+            Some(p) => p[i] as i32,
+            None => mesh.parent(i as u32) as i32,
+        };
         let mark = |i: usize| i32::from(marked.is_some_and(|m| m[i]));
         let cells = [
             CellArray::Int32With("level".into(), n, &level),
@@ -278,13 +285,18 @@ pub enum RefineError {
 
 /// The result of [`refine`].
 pub struct Refined {
-    /// The refined mesh, compact, with `parent` located in the input.
+    /// The refined mesh, compact; its `parent` values are the library's
+    /// nearby-tet hints until [`locate`] places them.
     pub mesh: TetMesh,
-    /// Per output tet: does it descend from a selected input tet?
-    pub marked: Vec<bool>,
+    /// Per input tet: was it selected? (`None`: uniform refinement.)
+    pub selection: Option<Vec<bool>>,
     /// Per step: the step report as JSON (phases, counts, seconds), with the
     /// `quality --json` fields when asked for.
     pub steps: Vec<String>,
+    /// Wall seconds of the work around the steps, as JSON: copy of the
+    /// input, feature detection, the steps, parent location, compaction and
+    /// the `marked` array.
+    pub timings: String,
 }
 
 /// Called at the start of every phase with (1-based step, phase name, live
@@ -366,7 +378,18 @@ pub fn refine(
     };
     // One copy: the input stays as it is (the Python object is immutable)
     // and serves to locate the parents afterwards.
+    let clock = std::time::Instant::now();
+    let mut lap = {
+        let mut last = clock.elapsed();
+        move || {
+            let now = clock.elapsed();
+            let d = (now - last).as_secs_f64();
+            last = now;
+            d
+        }
+    };
     let mut mesh = input.clone();
+    let t_copy = lap();
     {
         use tetrefine::refine::features::{detect_features, read_edge_list};
         match a.features.as_str() {
@@ -379,6 +402,7 @@ pub fn refine(
             }
         }
     }
+    let t_features = lap();
     let mut opts = RefineOptions {
         boundary,
         opt_passes: a.opt_passes,
@@ -409,21 +433,57 @@ pub fn refine(
         }
         steps.push(value.to_string());
     }
-    locate_parents(input, &mut mesh);
+    let t_steps = lap();
     mesh.compact();
-    let sel = selection.as_deref();
-    let marked = mesh
-        .tet_ids()
-        .map(|t| {
-            let p = mesh.parent(t) as usize;
-            sel.is_none_or(|s| s.get(p).copied().unwrap_or(false))
-        })
-        .collect();
+    let t_compact = lap();
+    let timings = serde_json::json!({
+        "copy": t_copy,
+        "features": t_features,
+        "steps": t_steps,
+        "compact": t_compact,
+    })
+    .to_string();
     Ok(Refined {
         mesh,
-        marked,
+        selection,
         steps,
+        timings,
     })
+}
+
+/// The parents of a refined mesh (`tetrefine refine`'s `locate_parents`:
+/// the input tet holding each tet's centroid, found by the library's walk
+/// from the step's hint) and the `marked` flags they give: does the tet
+/// descend from a selected input tet. The CLI does this after the steps; the
+/// package does it on first use of `parent`, `marked` or a `.vtu` write.
+pub fn locate(
+    input: &TetMesh,
+    mesh: &TetMesh,
+    selection: Option<&[bool]>,
+) -> (Vec<u32>, Vec<bool>) {
+    use rayon::prelude::*;
+    use tetrefine::refine::parents::walk_to;
+    let first = input.tet_ids().next().unwrap_or(0);
+    let parents: Vec<u32> = (0..mesh.n_tets() as u32)
+        .into_par_iter()
+        .with_min_len(1024)
+        .map(|t| {
+            let p = mesh.tet_points(t);
+            let c = (p[0] + p[1] + p[2] + p[3]) * 0.25;
+            let hint = mesh.parent(t);
+            let start = if (hint as usize) < input.n_tet_slots() && input.is_alive(hint) {
+                hint
+            } else {
+                first
+            };
+            walk_to(input, start, c)
+        })
+        .collect();
+    let marked = parents
+        .iter()
+        .map(|&p| selection.is_none_or(|s| s.get(p as usize).copied().unwrap_or(false)))
+        .collect();
+    (parents, marked)
 }
 
 /// `tetrefine improve`: edge removal and smoothing, boundary fixed, on a

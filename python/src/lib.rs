@@ -14,7 +14,7 @@ mod core_api;
 
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::PathBuf;
-use std::sync::Mutex;
+use std::sync::{Arc, Mutex, OnceLock};
 
 use numpy::ndarray::ArrayView2;
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyArrayMethods};
@@ -117,21 +117,71 @@ fn warn_notes(py: Python<'_>, what: &str, n: &BuildNotes) -> PyResult<()> {
 #[pyclass(frozen, module = "tetrefine", name = "Mesh")]
 pub struct Mesh {
     inner: TetMesh,
-    /// Per tet: descends from a tet selected by the refine() that made it.
-    marked: Option<Vec<bool>>,
+    /// For a mesh made by refine(), until its parents are located: the input
+    /// mesh and the selection (per input tet).
+    lineage: Mutex<Option<Lineage>>,
+    /// Located parents and the marked flags (refine() meshes, on first use).
+    located: OnceLock<(Vec<u32>, Vec<bool>)>,
     /// JSON reports of the operation that made the mesh (one per step).
     reports: Vec<String>,
+    /// JSON wall times of refine()'s parts (empty for other meshes).
+    timings: String,
     notes: BuildNotes,
+}
+
+/// Where a refined mesh came from: what locating its parents needs.
+struct Lineage {
+    input: Py<Mesh>,
+    selection: Option<Arc<Vec<bool>>>,
 }
 
 impl Mesh {
     fn new_plain(inner: TetMesh, notes: BuildNotes) -> Mesh {
+        Mesh::made(inner, Vec::new(), String::new(), notes, None)
+    }
+
+    fn made(
+        inner: TetMesh,
+        reports: Vec<String>,
+        timings: String,
+        notes: BuildNotes,
+        lineage: Option<Lineage>,
+    ) -> Mesh {
         Mesh {
             inner,
-            marked: None,
-            reports: Vec::new(),
+            lineage: Mutex::new(lineage),
+            located: OnceLock::new(),
+            reports,
+            timings,
             notes,
         }
+    }
+
+    /// The located parents and marked flags of a mesh made by refine()
+    /// (located on first use, with the GIL released); `None` for others.
+    fn located(&self, py: Python<'_>) -> PyResult<Option<&(Vec<u32>, Vec<bool>)>> {
+        if let Some(v) = self.located.get() {
+            return Ok(Some(v));
+        }
+        // The lock is held only while the GIL is, never across `detach`.
+        let (input, selection) = {
+            let g = self.lineage.lock().map_err(|_| {
+                PyRuntimeError::new_err("tetrefine: a parent location failed earlier")
+            })?;
+            match &*g {
+                Some(l) => (l.input.clone_ref(py), l.selection.clone()),
+                None => return Ok(self.located.get()),
+            }
+        };
+        let input_mesh = &input.get().inner;
+        let mesh = &self.inner;
+        let sel = selection.as_deref().map(Vec::as_slice);
+        let v = run_core(py, None, || core_api::locate(input_mesh, mesh, sel))?;
+        let _ = self.located.set(v);
+        if let Ok(mut g) = self.lineage.lock() {
+            *g = None; // the input may go now
+        }
+        Ok(self.located.get())
     }
 }
 
@@ -299,11 +349,16 @@ impl Mesh {
     }
 
     /// (n_tets,) uint32: after refine(), the input tet that holds each tet's
-    /// centroid (to carry solver fields over); for other meshes, the tet's
-    /// own index or the tet it was made from.
+    /// centroid (to carry solver fields over), located on first use as the
+    /// CLI locates it after the steps; for other meshes, the tet's own index
+    /// or the tet it was made from.
     #[getter]
     fn parent<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<u32>>> {
-        readonly(core_api::parents(&self.inner).into_pyarray(py))
+        let v = match self.located(py)? {
+            Some((p, _)) => p.clone(),
+            None => core_api::parents(&self.inner),
+        };
+        readonly(v.into_pyarray(py))
     }
 
     /// (n_tets,) bool: after refine(), whether the tet descends from a
@@ -311,8 +366,8 @@ impl Mesh {
     /// mesh that refine() did not make.
     #[getter]
     fn marked<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<bool>>> {
-        let v = match &self.marked {
-            Some(m) => m.clone(),
+        let v = match self.located(py)? {
+            Some((_, m)) => m.clone(),
             None => vec![false; core_api::n_tets(&self.inner)],
         };
         readonly(v.into_pyarray(py))
@@ -367,6 +422,18 @@ impl Mesh {
             .map(|s| json_value(py, s))
             .collect::<PyResult<Vec<_>>>()?;
         PyList::new(py, items)
+    }
+
+    /// For a mesh made by refine(): wall seconds of its parts — "copy" (of
+    /// the input), "features" (detection), "steps" (the √3 steps, as the
+    /// library's step clocks count them), "compact". (Parents are located
+    /// later, on first use.) None for other meshes.
+    #[getter]
+    fn timings<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyAny>>> {
+        if self.timings.is_empty() {
+            return Ok(None);
+        }
+        json_value(py, &self.timings).map(Some)
     }
 
     /// What building changed: reoriented tets, unreferenced points, dropped
@@ -436,9 +503,16 @@ impl Mesh {
     /// Raises OSError with the library's message; a failed write leaves no
     /// file behind.
     fn write(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
+        core_api::check_output_path(&path).map_err(PyOSError::new_err)?;
+        let is_vtu = path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("vtu"));
+        let located = if is_vtu { self.located(py)? } else { None };
+        let parents = located.map(|(p, _)| p.as_slice());
+        let marked = located.map(|(_, m)| m.as_slice());
         let mesh = &self.inner;
-        let marked = self.marked.as_deref();
-        run_core(py, None, || core_api::write(&path, mesh, marked))?.map_err(PyOSError::new_err)
+        run_core(py, None, || core_api::write(&path, mesh, parents, marked))?
+            .map_err(PyOSError::new_err)
     }
 
     /// refine(steps=1, *, boundary='interpolating', opt_passes=3, threshold=0.3,
@@ -517,7 +591,7 @@ impl Mesh {
     )]
     #[allow(clippy::too_many_arguments)]
     fn refine(
-        &self,
+        slf: &Bound<'_, Self>,
         py: Python<'_>,
         steps: usize,
         boundary: &str,
@@ -604,18 +678,23 @@ impl Mesh {
                 std::panic::resume_unwind(Box::new(Cancelled));
             }
         };
-        let mesh = &self.inner;
+        let this = slf.get();
+        let mesh = &this.inner;
         let ind = values.as_deref();
         let result = run_core(py, Some(&cancelled), || {
             core_api::refine(mesh, &args, ind, &hook)
         })?;
         match result {
-            Ok(r) => Ok(Mesh {
-                inner: r.mesh,
-                marked: Some(r.marked),
-                reports: r.steps,
-                notes: BuildNotes::default(),
-            }),
+            Ok(r) => Ok(Mesh::made(
+                r.mesh,
+                r.steps,
+                r.timings,
+                BuildNotes::default(),
+                Some(Lineage {
+                    input: slf.clone().unbind(),
+                    selection: r.selection.map(Arc::new),
+                }),
+            )),
             Err(core_api::RefineError::Value(m)) => Err(PyValueError::new_err(m)),
             Err(core_api::RefineError::File(m)) => Err(PyOSError::new_err(m)),
         }
@@ -636,12 +715,13 @@ impl Mesh {
         let mesh = &self.inner;
         let (m, report) = run_core(py, None, || core_api::improve(mesh, opt_passes, threshold))?
             .map_err(PyValueError::new_err)?;
-        Ok(Mesh {
-            inner: m,
-            marked: None,
-            reports: vec![report],
-            notes: BuildNotes::default(),
-        })
+        Ok(Mesh::made(
+            m,
+            vec![report],
+            String::new(),
+            BuildNotes::default(),
+            None,
+        ))
     }
 
     /// bisect(steps=1) -> Mesh
@@ -656,12 +736,13 @@ impl Mesh {
         let mesh = &self.inner;
         let (m, reports) =
             run_core(py, None, || core_api::bisect(mesh, steps))?.map_err(PyValueError::new_err)?;
-        Ok(Mesh {
-            inner: m,
-            marked: None,
+        Ok(Mesh::made(
+            m,
             reports,
-            notes: BuildNotes::default(),
-        })
+            String::new(),
+            BuildNotes::default(),
+            None,
+        ))
     }
 
     /// to_meshio(faces=True) -> meshio.Mesh

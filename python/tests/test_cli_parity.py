@@ -99,3 +99,18 @@ def test_improve_and_bisect_equal_cli(tmp_path, cli, cli_json):
     assert b.quality() == cli_json(bis)
     assert b.n_tets == 8 * m.n_tets  # closed form of 1:8 refinement
     assert b.reports[0]["tets"] == b.n_tets
+
+
+def test_parents_are_located_on_first_use_even_without_the_input():
+    kept = tetrefine.read(TRIPOD)
+    a = kept.refine(stop_after="split")
+    b = tetrefine.read(TRIPOD).refine(stop_after="split")  # its input is gone
+    import gc
+
+    gc.collect()
+    np.testing.assert_array_equal(a.parent, b.parent)
+    # After the 1-4 split alone every child lies in the tet it came from:
+    # each input tet is the parent of exactly 4 tets.
+    np.testing.assert_array_equal(np.bincount(b.parent), np.full(2799, 4))
+    assert set(b.timings) == {"copy", "features", "steps", "compact"}
+    assert b.timings["steps"] == pytest.approx(b.reports[0]["seconds"], abs=1e-6)
