@@ -113,4 +113,4 @@ def test_parents_are_located_on_first_use_even_without_the_input():
     # each input tet is the parent of exactly 4 tets.
     np.testing.assert_array_equal(np.bincount(b.parent), np.full(2799, 4))
     assert set(b.timings) == {"copy", "features", "steps", "compact"}
-    assert b.timings["steps"] == pytest.approx(b.reports[0]["seconds"], abs=1e-6)
+    assert b.timings["steps"] >= b.reports[0]["seconds"]  # the step clock is inside
