@@ -28,13 +28,14 @@
 #![warn(missing_docs)]
 
 pub mod geom;
+pub mod improve;
 pub mod io;
 pub mod mesh;
 pub mod ops;
 pub mod refine;
 pub mod report;
-pub mod smooth;
 pub mod surface;
+pub mod topo;
 #[cfg(feature = "tetgen")]
 pub mod tetgen;
 

@@ -8,7 +8,8 @@
 use std::collections::{HashMap, HashSet};
 use std::path::{Path, PathBuf};
 use std::process::Command;
-use tetrefine::geom::{tet_volume, TET_EDGES};
+use tetrefine::geom::tet_volume;
+use tetrefine::topo::TET_EDGES;
 use tetrefine::io::load_mesh;
 use tetrefine::mesh::edge_key;
 use tetrefine::ops::{

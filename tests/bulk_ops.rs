@@ -5,13 +5,14 @@
 //! seeded jittered cube with free slots, an adaptive selection, flips
 //! refused on purpose, and the flip phase repairing an invalid flip first.
 
-use tetrefine::geom::{orient3d, TET_EDGES};
+use tetrefine::geom::orient3d;
+use tetrefine::topo::TET_EDGES;
 use tetrefine::io::load_mesh;
 use tetrefine::mesh::generate::cube_grid;
 use tetrefine::ops::{
     flip23, flip23_bulk, flip23_valid, flip32, make_flips_valid, split14, split14_bulk, FlipBatch,
 };
-use tetrefine::smooth::ball_stays_positive;
+use tetrefine::mesh::ball_stays_positive;
 use tetrefine::TetMesh;
 
 /// The old split phase: `split14` on the selected tets in ascending order.

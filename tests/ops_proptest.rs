@@ -188,7 +188,7 @@ proptest! {
         let v0 = volume(&m);
         let faces0 = boundary_faces(&m);
         let t = m.tet_ids().next().unwrap();
-        let e = tetrefine::geom::TET_EDGES
+        let e = tetrefine::topo::TET_EDGES
             .iter()
             .position(|&[i, j]| {
                 let v = m.tet(t);

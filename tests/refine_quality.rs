@@ -5,7 +5,7 @@
 use std::path::Path;
 use tetrefine::io::load_mesh;
 use tetrefine::refine::{refine_step, BoundaryRule, RefineOptions};
-use tetrefine::smooth::{improve, ImproveOptions};
+use tetrefine::improve::{improve, ImproveOptions};
 use tetrefine::MeshStats;
 
 #[test]

@@ -8,8 +8,9 @@ use std::path::Path;
 use tetrefine::geom::{orient3d, tet_min_sine};
 use tetrefine::io::load_mesh;
 use tetrefine::mesh::generate::cube_grid;
-use tetrefine::smooth::colour::{colour_balls_except, colour_classes, sequential_levels, Balls};
-use tetrefine::smooth::{ball_stays_positive, fixed_vertices, improve, ImproveOptions};
+use tetrefine::improve::colour::{colour_balls_except, colour_classes, sequential_levels, Balls};
+use tetrefine::improve::{fixed_vertices, improve, ImproveOptions};
+use tetrefine::mesh::ball_stays_positive;
 use tetrefine::TetMesh;
 
 fn worst_quality(mesh: &TetMesh) -> f64 {
@@ -70,7 +71,7 @@ fn improve_with(
     mesh: &TetMesh,
     threads: usize,
     opts: &ImproveOptions,
-) -> (TetMesh, tetrefine::smooth::ImproveReport) {
+) -> (TetMesh, tetrefine::improve::ImproveReport) {
     let mut m = mesh.clone();
     let report = in_pool(threads, || improve(&mut m, opts));
     (m, report)
@@ -79,7 +80,7 @@ fn improve_with(
 fn improve_with_threads(
     mesh: &TetMesh,
     threads: usize,
-) -> (TetMesh, tetrefine::smooth::ImproveReport) {
+) -> (TetMesh, tetrefine::improve::ImproveReport) {
     improve_with(mesh, threads, &ImproveOptions::default())
 }
 

@@ -2,7 +2,7 @@
 //! boundary fixed — a mesh clean-up tool.
 
 use std::path::PathBuf;
-use tetrefine::smooth::{improve, ImproveOptions};
+use tetrefine::improve::{improve, ImproveOptions};
 use tetrefine::MeshStats;
 
 /// Arguments of `improve`.

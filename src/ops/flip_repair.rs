@@ -23,7 +23,7 @@
 
 use super::FlipBatch;
 use crate::mesh::{TetMesh, NO_ADJ};
-use crate::smooth::ball_stays_positive;
+use crate::mesh::ball_stays_positive;
 use glam::DVec3;
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicU32, Ordering};

@@ -17,7 +17,7 @@
 
 use super::edge_removal::{best_ring_triangulation, EdgeRing};
 use super::{replace_cavity_raw, OpError};
-use crate::geom::TET_FACES;
+use crate::topo::TET_FACES;
 use crate::mesh::{TetMesh, NO_ADJ};
 use glam::DVec3;
 

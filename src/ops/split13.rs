@@ -13,7 +13,7 @@
 //! Kobbelt's √3 1-3 split.
 
 use super::{replace_cavity, OpError};
-use crate::geom::TET_FACES;
+use crate::topo::TET_FACES;
 use crate::mesh::TetMesh;
 use glam::DVec3;
 

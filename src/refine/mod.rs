@@ -11,7 +11,7 @@
 //! 5. `boundary-smooth` — the √3 stencils of [`crate::surface::sqrt3`] move the
 //!    boundary points; a move that would invert a tet is shortened or skipped;
 //! 6. `optimize` — interior edge removal and vertex smoothing
-//!    ([`crate::smooth::improve`]).
+//!    ([`crate::improve::improve`]).
 //!
 //! A step renumbers tets and points (it compacts the mesh and sorts it along
 //! a space-filling curve before `optimize`), so ids held across a step are
@@ -42,7 +42,7 @@ pub struct NoProgress;
 
 impl Progress for NoProgress {}
 
-use crate::smooth::ImproveReport;
+use crate::improve::ImproveReport;
 use crate::surface::sqrt3::Sqrt3Rule;
 use serde::Serialize;
 use std::fmt;

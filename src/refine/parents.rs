@@ -1,6 +1,7 @@
 //! The `parent` of an output tet: the input tet that holds its centroid.
 
-use crate::geom::{orient3d, TET_FACES};
+use crate::geom::orient3d;
+use crate::topo::TET_FACES;
 use crate::mesh::fasthash::FastHashSet;
 use crate::mesh::{TetMesh, NO_ADJ};
 use glam::DVec3;

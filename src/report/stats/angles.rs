@@ -18,7 +18,7 @@
 //!   and `sqrt` alone, so it is the same bits on every machine and in the
 //!   vector and scalar code.
 
-use crate::geom::TET_EDGE_OPPOSITE;
+use crate::topo::TET_EDGE_OPPOSITE;
 use crate::report::stats::Histogram;
 use std::cmp::Ordering;
 

@@ -26,7 +26,7 @@
 //! valence is counted exactly, by collecting the neighbours of those vertices
 //! ([`count_neighbours`]).
 
-use crate::geom::TET_FACES;
+use crate::topo::TET_FACES;
 use crate::mesh::{TetMesh, DEAD, NO_ADJ};
 use rayon::prelude::*;
 

@@ -5,30 +5,17 @@
 //! the dihedral angles of a tet, and for a vertex the minimum over its ball.
 
 pub mod colour;
-pub mod improve;
+pub mod passes;
 pub mod laplacian;
 pub mod optimize;
 pub mod ring;
 
-pub use improve::{fixed_vertices, improve, ImproveOptions, ImproveReport};
+pub use passes::{fixed_vertices, improve, ImproveOptions, ImproveReport};
 
-use crate::geom::{orient3d, tet_min_sine};
-use crate::mesh::TetMesh;
+use crate::geom::{all_positive, tet_min_sine};
+use crate::mesh::{tet_points_with, TetMesh};
 use glam::DVec3;
 use std::cell::RefCell;
-
-/// The corners of tet `t` with vertex `v` (if it is one of them) standing at `x`.
-#[inline]
-pub fn tet_points_with(mesh: &TetMesh, t: u32, v: u32, x: DVec3) -> [DVec3; 4] {
-    let tv = mesh.tet(t);
-    let mut p = mesh.tet_points(t);
-    for (pi, &vi) in p.iter_mut().zip(&tv) {
-        if vi == v {
-            *pi = x;
-        }
-    }
-    p
-}
 
 /// Smallest quality over the tets of `ball` if vertex `v` stood at `x`.
 pub fn ball_quality_at(mesh: &TetMesh, v: u32, ball: &[u32], x: DVec3) -> f64 {
@@ -58,15 +45,6 @@ pub fn ball_quality(mesh: &TetMesh, ball: &[u32]) -> f64 {
     ball.iter()
         .map(|&t| tet_min_sine(&mesh.tet_points(t)))
         .fold(f64::INFINITY, f64::min)
-}
-
-/// Whether every tet of `ball` stays positively oriented (exact predicate) with
-/// vertex `v` at `x`.
-pub fn ball_stays_positive(mesh: &TetMesh, v: u32, ball: &[u32], x: DVec3) -> bool {
-    ball.iter().all(|&t| {
-        let p = tet_points_with(mesh, t, v, x);
-        orient3d(p[0], p[1], p[2], p[3]) > 0.0
-    })
 }
 
 /// Runs `f` on this thread's "seen in this call" stamps, one per point of a
@@ -202,9 +180,6 @@ impl BallPoints {
     /// Whether every tet stays positively oriented (exact predicate) with the
     /// vertex at `x`.
     pub fn stays_positive(&self, x: DVec3) -> bool {
-        (0..self.pts.len()).all(|i| {
-            let p = self.tet_with(i, x);
-            orient3d(p[0], p[1], p[2], p[3]) > 0.0
-        })
+        all_positive((0..self.pts.len()).map(|i| self.tet_with(i, x)))
     }
 }

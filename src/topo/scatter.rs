@@ -1,5 +1,6 @@
-//! Shared machinery of the bulk (data-parallel) operations
-//! [`super::bulk_split`] and [`super::bulk_flip`].
+//! Parallel scatter helpers of the bulk (data-parallel) operations
+//! (`ops::bulk_split`, `ops::bulk_flip`) and of the store's own parallel
+//! builds: the only `unsafe` of the core.
 //!
 //! A bulk operation applies one local operation to many disjoint cavities at
 //! once. Each parallel task owns its cavity's slots and the one adjacency

@@ -16,7 +16,7 @@
 //! colour byte per point rather than a colour mask per tet.
 
 use crate::mesh::{TetMesh, DEAD};
-use crate::ops::bulk::Disjoint;
+use crate::topo::scatter::Disjoint;
 use rayon::prelude::*;
 
 /// The balls (incident tets) of a list of vertices, in one flat array.
