@@ -95,7 +95,7 @@ f 2 3 7 6
 f 3 4 8 7
 f 4 1 5 8
 OBJ
-cat >"$work/in/tet.off" <<'OFF'
+cat >"$work/in/tet.off" <<'EOT'
 OFF
 4 4 6
 0 0 0
@@ -106,7 +106,7 @@ OFF
 3 0 1 3
 3 0 3 2
 3 1 2 3
-OFF
+EOT
 cat >"$work/in/strip.ply" <<'PLY'
 ply
 format ascii 1.0

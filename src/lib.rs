@@ -27,6 +27,7 @@
 
 #![warn(missing_docs)]
 
+pub mod file;
 pub mod geom;
 pub mod improve;
 pub mod io;
@@ -34,10 +35,10 @@ pub mod mesh;
 pub mod ops;
 pub mod refine;
 pub mod report;
-pub mod surface;
-pub mod topo;
+pub mod stencil;
 #[cfg(feature = "tetgen")]
 pub mod tetgen;
+pub mod topo;
 
 pub use mesh::{MeshData, TetMesh};
 pub use report::MeshStats;

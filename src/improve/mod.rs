@@ -5,9 +5,9 @@
 //! the dihedral angles of a tet, and for a vertex the minimum over its ball.
 
 pub mod colour;
-pub mod passes;
 pub mod laplacian;
 pub mod optimize;
+pub mod passes;
 pub mod ring;
 
 pub use passes::{fixed_vertices, improve, ImproveOptions, ImproveReport};

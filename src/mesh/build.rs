@@ -3,8 +3,8 @@
 
 use super::{edge_key, face_key, MeshData, TetMesh, NO_ADJ};
 use crate::geom::{orient3d_sign, Orientation};
-use crate::topo::TET_FACES;
 use crate::topo::scatter::Disjoint;
+use crate::topo::TET_FACES;
 use glam::DVec3;
 use rayon::prelude::*;
 use std::collections::{HashMap, HashSet};

@@ -23,13 +23,13 @@ pub mod generate;
 mod moves;
 mod reorder;
 
+/// The store's keys of sparse tags (defined once, in [`crate::topo`]).
+pub use crate::topo::{edge_key, face_key, EdgeKey, FaceKey};
 pub use build::{BuildReport, MeshError};
 pub use check::CheckError;
 pub use compact::Remap;
 pub use data::MeshData;
 pub use moves::{ball_stays_positive, tet_points_with};
-/// The store's keys of sparse tags (defined once, in [`crate::topo`]).
-pub use crate::topo::{edge_key, face_key, EdgeKey, FaceKey};
 
 use crate::topo::{TET_EDGES, TET_EDGE_OPPOSITE, TET_FACES};
 use fasthash::{FastHashMap, FastHashSet};

@@ -22,4 +22,3 @@ pub fn tet_points_with(mesh: &TetMesh, t: u32, v: u32, x: DVec3) -> [DVec3; 4] {
 pub fn ball_stays_positive(mesh: &TetMesh, v: u32, ball: &[u32], x: DVec3) -> bool {
     all_positive(ball.iter().map(|&t| tet_points_with(mesh, t, v, x)))
 }
-

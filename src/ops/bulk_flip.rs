@@ -28,11 +28,11 @@
 //! The result equals calling [`super::flip23`] on the faces in order (same
 //! slots, generations and vertex → tet entries). Seed paper §3.1 (Figure 5).
 
-use crate::topo::scatter::{Disjoint, LastTouch};
 use super::is_constrained_face;
 use crate::geom::all_positive;
-use crate::topo::TET_FACES;
 use crate::mesh::{TetMesh, DEAD, NO_ADJ};
+use crate::topo::scatter::{Disjoint, LastTouch};
+use crate::topo::TET_FACES;
 use glam::DVec3;
 use rayon::prelude::*;
 

@@ -27,9 +27,9 @@
 //! (allocate by prefix sum, fill in parallel) is the usual one of bulk mesh
 //! refinement.
 
-use crate::topo::scatter::{Disjoint, LastTouch};
 use crate::geom::all_positive;
 use crate::mesh::{TetMesh, DEAD, NO_ADJ};
+use crate::topo::scatter::{Disjoint, LastTouch};
 use glam::DVec3;
 use rayon::prelude::*;
 

@@ -21,8 +21,8 @@
 
 use super::{replace_cavity, OpError};
 use crate::geom::{orient3d, tet_min_sine};
-use crate::topo::{TET_EDGES, TET_EDGE_OPPOSITE};
 use crate::mesh::{TetMesh, NO_ADJ};
+use crate::topo::{TET_EDGES, TET_EDGE_OPPOSITE};
 
 /// The tets around an edge `(a, b)` in rotational order.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]

@@ -18,8 +18,8 @@ pub mod split13;
 pub mod split14;
 pub mod trisect;
 
-use crate::topo::TET_FACES;
 use crate::mesh::{face_key, FaceKey, TetMesh, NO_ADJ};
+use crate::topo::TET_FACES;
 
 pub use bulk_flip::{flip23_bulk, FlipBatch};
 pub use bulk_split::split14_bulk;

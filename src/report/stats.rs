@@ -20,8 +20,8 @@ mod angles;
 mod topology;
 
 use crate::geom::is_positive;
-use crate::topo::TET_FACES;
 use crate::mesh::{TetMesh, DEAD, NO_ADJ};
+use crate::topo::TET_FACES;
 use angles::{cosine_extremes, lanes, BinThresholds, LaneVec, LANES};
 use glam::DVec3;
 use rayon::prelude::*;
@@ -518,9 +518,9 @@ fn finite_or_zero(x: f64) -> f64 {
 mod tests {
     use super::*;
     use crate::geom::{orient3d_sign, tet_quality, Orientation};
-use crate::topo::TET_EDGES;
     use crate::mesh::generate::cube_grid;
     use crate::mesh::{edge_key, MeshData};
+    use crate::topo::TET_EDGES;
     use std::collections::HashSet;
 
     fn xorshift(mut s: u64) -> impl FnMut() -> f64 {

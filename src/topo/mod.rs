@@ -42,7 +42,10 @@ pub const EDGE_OF: [[u8; 4]; 4] = [[6, 0, 1, 2], [0, 6, 3, 4], [1, 3, 6, 5], [2,
 /// The local edge joining local vertices `i != j`.
 #[inline]
 pub fn local_edge(i: usize, j: usize) -> usize {
-    debug_assert!(i < 4 && j < 4 && i != j, "no edge joins local vertices {i} and {j}");
+    debug_assert!(
+        i < 4 && j < 4 && i != j,
+        "no edge joins local vertices {i} and {j}"
+    );
     EDGE_OF[i][j] as usize
 }
 
