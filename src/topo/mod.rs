@@ -89,8 +89,8 @@ mod tests {
             assert_eq!(local_edge(i, j), e);
             assert_eq!(local_edge(j, i), e);
         }
-        for i in 0..4 {
-            assert_eq!(EDGE_OF[i][i], NO_EDGE);
+        for (i, row) in EDGE_OF.iter().enumerate() {
+            assert_eq!(row[i], NO_EDGE);
         }
     }
 

@@ -20,7 +20,9 @@ use tetrefine::topo::TET_EDGES;
 use tetrefine::TetMesh;
 
 fn load(name: &str) -> TetMesh {
-    load_mesh(&crate::support::path("meshes").join(name)).unwrap().0
+    load_mesh(&crate::support::path("meshes").join(name))
+        .unwrap()
+        .0
 }
 
 /// Distinct edges, counted independently of the code under test.
