@@ -493,7 +493,7 @@ pub fn improve(
     passes: usize,
     threshold: f64,
 ) -> Result<(TetMesh, String), String> {
-    use tetrefine::smooth::{improve, ImproveOptions};
+    use tetrefine::improve::{improve, ImproveOptions};
     if !(threshold > 0.0 && threshold < 1.0) {
         return Err(format!("threshold={threshold} must lie in (0, 1) (a sine)"));
     }
