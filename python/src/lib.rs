@@ -456,8 +456,6 @@ impl Mesh {
         )
     }
 
-    /// quality(bins=71) -> dict
-    ///
     /// The statistics of `tetrefine quality --json`, as a dict with the same
     /// keys: nodes, edges, tets, boundary_faces, interior_faces,
     /// min_dihedral_deg {worst, avg, best}, max_dihedral_deg {worst, avg},
@@ -478,8 +476,6 @@ impl Mesh {
         json_value(py, &text)
     }
 
-    /// tet_quality() -> dict of (n_tets,) float64 arrays
-    ///
     /// Per tet, the cell arrays tetrefine writes into .vtu files:
     /// "min_dihedral" and "max_dihedral" (degrees), "quality" (the paper's
     /// measure: minimum sine of the signed dihedral angles, 0.9428 for the
@@ -495,8 +491,6 @@ impl Mesh {
         Ok(d)
     }
 
-    /// write(path)
-    ///
     /// Writes the mesh; the format follows the extension, as for the CLI:
     /// .mesh (Medit), .msh (Gmsh 4.1), .vtu (VTK XML, with the quality cell
     /// arrays and level, parent, marked for ParaView), .node/.ele (TetGen).
@@ -515,12 +509,6 @@ impl Mesh {
             .map_err(PyOSError::new_err)
     }
 
-    /// refine(steps=1, *, boundary='interpolating', opt_passes=3, threshold=0.3,
-    ///        stop_after=None, features='auto', feature_angle=45.0,
-    ///        indicator=None, mark='doerfler:0.5', region=None, box=None,
-    ///        sphere=None, smooth='refined', step_offset=0, progress=False,
-    ///        stats=False) -> Mesh
-    ///
     /// Refine with the √3 tetrahedral subdivision (uniform, or adaptive with
     /// a selection) — `tetrefine refine`. Returns a new Mesh; this one is
     /// left as it is. The new mesh's `reports` hold one dict per step.
@@ -700,8 +688,6 @@ impl Mesh {
         }
     }
 
-    /// improve(opt_passes=5, *, threshold=0.3) -> Mesh
-    ///
     /// Improve the mesh (edge removal and smoothing), boundary fixed —
     /// `tetrefine improve`. Returns a new Mesh whose `reports` hold one dict
     /// (passes, edges_removed, laplacian_moves, optimized_moves).
@@ -724,8 +710,6 @@ impl Mesh {
         ))
     }
 
-    /// bisect(steps=1) -> Mesh
-    ///
     /// Uniform 1:8 red refinement by edge bisection (the speed-of-light
     /// reference) — `tetrefine bisect`. Returns a new Mesh whose `reports`
     /// hold one dict per step (tets, points, seconds).
@@ -745,8 +729,6 @@ impl Mesh {
         ))
     }
 
-    /// to_meshio(faces=True) -> meshio.Mesh
-    ///
     /// The mesh as a meshio.Mesh (needs meshio): a "tetra" block with cell
     /// data region, level, parent, marked, min_dihedral, max_dihedral,
     /// quality, volume (and medit:ref, gmsh:physical, gmsh:geometrical =
@@ -763,8 +745,6 @@ impl Mesh {
             .call1((slf, faces))
     }
 
-    /// to_pyvista() -> pyvista.UnstructuredGrid
-    ///
     /// The tets as a PyVista grid (needs pyvista) with cell data region,
     /// level, parent, marked, min_dihedral, max_dihedral, quality, volume.
     fn to_pyvista<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyAny>> {
@@ -791,8 +771,6 @@ impl<'a, 'py> FromPyObject<'a, 'py> for PathOrName {
     }
 }
 
-/// read(path) -> Mesh
-///
 /// Reads a mesh file; the format follows the extension, as for the CLI:
 /// .mesh (Medit/MMG), .msh (Gmsh 2.2/4.1 ASCII or binary, or GiD — told
 /// apart by the first keyword), .vtu (VTK XML), .node/.ele/.face (TetGen).
@@ -821,9 +799,6 @@ fn _panic_for_tests(py: Python<'_>) -> PyResult<()> {
     })
 }
 
-/// mesh_surface(surface, *, min_ratio=None, min_dihedral=None,
-///              max_volume=None, switches=None) -> Mesh
-///
 /// Mesh the volume a closed surface encloses, with TetGen — `tetrefine
 /// mesh`. Only in builds with the `tetgen` feature (TetGen is AGPL-3):
 /// `MATURIN_PEP517_ARGS="--features tetgen" pip install ./python`.

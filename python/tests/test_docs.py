@@ -36,8 +36,11 @@ def test_refine_help_covers_every_cli_flag(cli):
             assert target is None or hasattr(tetrefine.Mesh, target), flag
         else:
             assert f"[{flag}]" in doc, f"help(Mesh.refine) does not mention {flag}"
-    # It reads like --help: a usage line, then one entry per option.
-    assert doc.startswith("refine(steps=1, *, boundary='interpolating'")
+    # It reads like --help: the usage line, a summary, one entry per option.
+    assert str(inspect.signature(tetrefine.Mesh.refine)).startswith(
+        "(self, steps=1, *, boundary='interpolating'"
+    )
+    assert doc.startswith("Refine with the √3 tetrahedral subdivision")
     assert "Options (the CLI flag in brackets):" in doc
 
 
