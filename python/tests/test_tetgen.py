@@ -8,7 +8,7 @@ import tetrefine
 from conftest import MESHES
 
 
-def test_mesh_surface_only_with_tetgen(tmp_path, cli):
+def test_mesh_surface_only_with_tetgen(tmp_path):
     if not tetrefine.HAS_TETGEN:
         assert not hasattr(tetrefine, "mesh_surface")
         with pytest.raises(AttributeError, match="built without TetGen"):
