@@ -350,8 +350,9 @@ impl Mesh {
 
     /// (n_tets,) uint32: after refine(), the input tet that holds each tet's
     /// centroid (to carry solver fields over), located on first use as the
-    /// CLI locates it after the steps; for other meshes, the tet's own index
-    /// or the tet it was made from.
+    /// CLI locates it after the steps (until then the refined mesh keeps
+    /// its input alive); for other meshes, the tet's own index or the tet it
+    /// was made from.
     #[getter]
     fn parent<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<u32>>> {
         let v = match self.located(py)? {
