@@ -48,10 +48,11 @@ def test_gil_is_released_during_refinement(cube):
         time.sleep(0.002)
     t.join()
     elapsed = time.perf_counter() - t0
-    # With the GIL held for the whole run this loop could only tick at the
-    # six phase boundaries; released, it ticks all along (~one per 2 ms).
+    # With the GIL held for the whole run this loop could only tick around
+    # the six phase boundaries (a few ticks each); released, it ticks all
+    # along (one per 2 ms, fewer on a loaded machine).
     assert elapsed > 0.1
-    assert ticks > 0.25 * elapsed / 0.002
+    assert ticks > max(30, 0.1 * elapsed / 0.002)
 
 
 def test_interrupt_main_stops_a_long_run(cube, one_step_seconds):
