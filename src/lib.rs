@@ -33,8 +33,10 @@ pub mod improve;
 pub mod io;
 pub mod mesh;
 pub mod ops;
+pub mod polyline;
 pub mod refine;
 pub mod report;
+pub mod rng;
 pub mod stencil;
 #[cfg(feature = "tetgen")]
 pub mod tetgen;

@@ -17,20 +17,34 @@ use std::time::Instant;
 
 /// Runs `steps` refinement steps; one report per step.
 ///
-/// With a selection (adaptive refinement, seed paper §6), step 1 splits the
-/// selected tets and every later step splits their descendants again — the
-/// tets whose `level` the previous step raised — so the selected zone is
+/// With a selection (adaptive refinement, the √3 paper's §6), step 1 splits
+/// the selected tets and every later step splits their descendants again —
+/// the tets whose `level` the previous step raised — so the selected zone is
 /// refined `steps` times (the paper's Figure 13).
 pub fn refine(mesh: &mut TetMesh, steps: usize, opts: &RefineOptions) -> Vec<StepReport> {
     let mut reports = Vec::with_capacity(steps);
+    refine_with(mesh, steps, opts, &NoProgress, |_, _, r| reports.push(r));
+    reports
+}
+
+/// [`refine`] with progress callbacks and a callback after every step:
+/// `on_step(step, mesh, report)` sees the mesh as the 1-based `step` left it
+/// (statistics, intermediate files) before the next step begins.
+pub fn refine_with(
+    mesh: &mut TetMesh,
+    steps: usize,
+    opts: &RefineOptions,
+    progress: &dyn Progress,
+    mut on_step: impl FnMut(usize, &TetMesh, StepReport),
+) {
     let mut step_opts = opts.clone();
     for s in 1..=steps {
         if s > 1 && opts.selection.is_some() {
             step_opts.selection = Some(descendants_of_last_step(mesh, s - 1));
         }
-        reports.push(refine_step(mesh, s, &step_opts));
+        let report = refine_step_with_progress(mesh, s, &step_opts, progress);
+        on_step(s, mesh, report);
     }
-    reports
 }
 
 /// Per tet slot: was it refined in step `step` (its level is `step`)? With a

@@ -6,7 +6,7 @@
 //! nothing depends on the fonts of the machine.
 
 use super::Histogram;
-use crate::io::{write_atomic, IoError};
+use crate::file::{write_atomic, IoError};
 use plotters::prelude::*;
 use std::io::Write;
 use std::path::Path;
