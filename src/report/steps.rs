@@ -2,7 +2,7 @@
 
 use super::MeshStats;
 
-/// Header of the per-step table (the rows of Table 1 of the seed paper as
+/// Header of the per-step table (the rows of Table 1 of the √3 paper (Burkhart, Hamann and Umlauf) as
 /// columns, plus boundary faces, inverted tets, feature edges, corners and
 /// wall time).
 pub fn step_table_header() -> String {

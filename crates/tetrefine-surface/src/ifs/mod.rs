@@ -1,5 +1,5 @@
 //! Subdivision curves and surfaces as attractors of iterated function systems
-//! (seed paper `003`: Schaefer, Levin and Goldman, "Subdivision schemes and
+//! (Schaefer, Levin and Goldman, "Subdivision schemes and
 //! attractors"), and the Koch curve and Sierpinski gasket as subdivision
 //! schemes with movable control points (same paper, §4).
 //!
