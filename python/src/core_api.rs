@@ -14,8 +14,8 @@ use std::path::Path;
 use tetrefine::io::vtk::CellArray;
 use tetrefine::mesh::MeshData;
 use tetrefine::refine::marking::{select, MarkStrategy};
-use tetrefine::refine::step::descendants_of_last_step;
-use tetrefine::refine::{refine_step_with_progress, Phase, Progress, RefineOptions};
+use tetrefine::refine::step::refine_with;
+use tetrefine::refine::{Phase, Progress, RefineOptions};
 use tetrefine::report::stats::DEFAULT_HIST_MAX_DEG;
 use tetrefine::report::Histogram;
 use tetrefine::MeshStats;
@@ -310,7 +310,12 @@ struct HookProgress<'a> {
 
 impl Progress for HookProgress<'_> {
     fn phase_start(&self, phase: Phase, total: u64) {
-        let step = self.step.load(std::sync::atomic::Ordering::Relaxed);
+        use std::sync::atomic::Ordering::Relaxed;
+        // Every step begins with the split phase.
+        if phase == Phase::Split {
+            self.step.fetch_add(1, Relaxed);
+        }
+        let step = self.step.load(Relaxed);
         (self.hook)(step, phase.name(), total);
     }
 }
@@ -391,7 +396,8 @@ pub fn refine(
     let mut mesh = input.clone();
     let t_copy = lap();
     {
-        use tetrefine::refine::features::{detect_features, read_edge_list};
+        use tetrefine::io::edges::read_edge_list;
+        use tetrefine::refine::features::detect_features;
         match a.features.as_str() {
             "none" => mesh.clear_features(),
             "auto" => {
@@ -403,7 +409,7 @@ pub fn refine(
         }
     }
     let t_features = lap();
-    let mut opts = RefineOptions {
+    let opts = RefineOptions {
         boundary,
         opt_passes: a.opt_passes,
         threshold: a.threshold,
@@ -418,21 +424,18 @@ pub fn refine(
         step: std::sync::atomic::AtomicUsize::new(0),
     };
     let mut steps = Vec::with_capacity(a.steps);
-    for s in 1..=a.steps {
-        progress.step.store(s, std::sync::atomic::Ordering::Relaxed);
-        if s > 1 && opts.selection.is_some() {
-            opts.selection = Some(descendants_of_last_step(&mesh, s - 1));
-        }
-        let report = refine_step_with_progress(&mut mesh, s, &opts, &progress);
+    // The library's step loop (the CLI's too): it selects the descendants of
+    // the selection for every later step.
+    refine_with(&mut mesh, a.steps, &opts, &progress, |_, m, report| {
         let mut value = serde_json::to_value(&report).unwrap_or_default();
         if a.stats {
-            let stats = serde_json::to_value(MeshStats::compute(&mesh)).unwrap_or_default();
+            let stats = serde_json::to_value(MeshStats::compute(m)).unwrap_or_default();
             if let (Some(obj), serde_json::Value::Object(q)) = (value.as_object_mut(), stats) {
                 obj.insert("quality".into(), serde_json::Value::Object(q));
             }
         }
         steps.push(value.to_string());
-    }
+    });
     let t_steps = lap();
     mesh.compact();
     let t_compact = lap();
