@@ -8,10 +8,18 @@
 //! store [`TetMesh`] (adjacency, exact orientation, tag side tables), and
 //! judged by [`MeshStats`] — the figures of Table 1 of the paper.
 //!
+//! The crate root re-exports what a library user needs: reading and writing
+//! meshes ([`load_mesh`], [`read_mesh`], [`write_mesh`]), the store
+//! ([`TetMesh`]: read access and checked operations; the primitives that
+//! could break its invariants are crate-private), refinement ([`refine`],
+//! [`refine_with`] with a per-step callback, [`RefineOptions`],
+//! [`StepReport`]), marking ([`MarkStrategy`], [`select`]), improvement
+//! ([`improve`]) and statistics ([`MeshStats`], [`format_table`]). TetGen is
+//! behind the `tetgen` feature.
+//!
 //! ```
 //! use std::path::Path;
-//! use tetrefine::io::load_mesh;
-//! use tetrefine::MeshStats;
+//! use tetrefine::{format_table, load_mesh, MeshStats};
 //!
 //! let (mesh, _report) = load_mesh(Path::new("meshes/tripod.mesh"))?;
 //! mesh.check()?; // adjacency, exact orientation, manifold boundary, tags
@@ -21,7 +29,7 @@
 //!     "{} tets, worst minimum dihedral angle {:.2}°",
 //!     stats.tets, stats.min_dihedral_deg.worst
 //! );
-//! print!("{}", tetrefine::report::format_table(&[("tripod", &stats)]));
+//! print!("{}", format_table(&[("tripod", &stats)]));
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
@@ -43,8 +51,18 @@ pub mod stencil;
 pub mod tetgen;
 pub mod topo;
 
-pub use mesh::{MeshData, TetMesh};
-pub use report::MeshStats;
+pub use file::IoError;
+pub use improve::{improve, ImproveOptions, ImproveReport};
+pub use io::{load_mesh, read_mesh, write_mesh};
+pub use mesh::{BuildReport, CheckError, MeshData, MeshError, Remap, TetMesh, Where};
+pub use ops::OpError;
+pub use refine::marking::{select, MarkStrategy};
+pub use refine::{
+    locate_parents, refine, refine_step, refine_with, NoProgress, Phase, PhaseReport, Progress,
+    RefineOptions, StepReport,
+};
+pub use report::{format_table, write_histogram, MeshStats};
+pub use stencil::Sqrt3Rule;
 
 /// The README's Rust examples, compiled and run as doctests so that they stay
 /// true.

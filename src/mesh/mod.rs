@@ -25,7 +25,7 @@ mod reorder;
 
 /// The store's keys of sparse tags (defined once, in [`crate::topo`]).
 pub use crate::topo::{edge_key, face_key, EdgeKey, FaceKey};
-pub use build::{BuildReport, MeshError};
+pub use build::{BuildReport, MeshError, Where};
 pub use check::CheckError;
 pub use compact::Remap;
 pub use data::MeshData;
