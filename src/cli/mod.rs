@@ -11,7 +11,7 @@ pub mod refine;
 pub mod surface;
 
 use std::path::Path;
-use tetrefine::io::vtk::CellArray;
+use tetrefine::io::vtk::{CellArray, VtuSummary};
 use tetrefine::report::histogram::{write_histogram as write_hist_file, HistogramFormat};
 use tetrefine::report::MeshStats;
 use tetrefine::TetMesh;
@@ -100,7 +100,33 @@ pub fn write_refined(
                 .iter()
                 .map(|(name, f)| CellArray::Int32With(name.to_string(), n, f)),
         );
-        tetrefine::io::vtk::write_vtu(path, mesh, &cells).map_err(|e| e.to_string())
+        let (valence, stats) = (MeshStats::vertex_valence(mesh), MeshStats::compute(mesh));
+        let summary = vtu_summary(&valence, &stats);
+        tetrefine::io::vtk::write_vtu(path, mesh, Some(&summary), &cells)
+            .map_err(|e| e.to_string())
+    } else {
+        tetrefine::io::write_mesh(path, mesh).map_err(|e| e.to_string())
+    }
+}
+
+/// The figures a `.vtu` carries besides the mesh, from the statistics.
+fn vtu_summary<'a>(valence: &'a [u32], stats: &'a MeshStats) -> VtuSummary<'a> {
+    VtuSummary {
+        valence,
+        histogram_counts: &stats.histogram.counts,
+        histogram_edges_deg: &stats.histogram.edges_deg,
+    }
+}
+
+/// Writes `mesh` in the format of `path`'s extension; a `.vtu` also gets the
+/// point valences and the minimum-dihedral histogram of the statistics.
+pub fn write_mesh(path: &Path, mesh: &TetMesh) -> CliResult {
+    let is_vtu = tetrefine::io::Format::for_writing(path).map_err(|e| e.to_string())?
+        == tetrefine::io::Format::Vtu;
+    if is_vtu {
+        let (valence, stats) = (MeshStats::vertex_valence(mesh), MeshStats::compute(mesh));
+        let summary = vtu_summary(&valence, &stats);
+        tetrefine::io::vtk::write_vtu(path, mesh, Some(&summary), &[]).map_err(|e| e.to_string())
     } else {
         tetrefine::io::write_mesh(path, mesh).map_err(|e| e.to_string())
     }

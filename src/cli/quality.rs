@@ -69,7 +69,7 @@ pub fn run(a: Args) -> super::CliResult {
     // The mesh first: its writer is the likelier to refuse (format support),
     // and then no file at all is left behind.
     if let Some(o) = &a.output {
-        tetrefine::io::write_mesh(o, &mesh).map_err(|e| e.to_string())?;
+        super::write_mesh(o, &mesh)?;
         eprintln!("wrote mesh {}", o.display());
     }
     if let Some(h) = &a.histogram {

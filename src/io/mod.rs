@@ -6,6 +6,8 @@
 //! the file and, where there is one, the line. Writers go through
 //! [`write_atomic`], so a failed write never leaves a partial file behind.
 
+mod atomic;
+mod error;
 pub mod gid;
 pub mod gmsh;
 pub mod indicator;
@@ -18,56 +20,18 @@ pub mod tetgen;
 mod text;
 pub mod vtk;
 
+pub use atomic::{
+    install_signal_cleanup, remove_stale_temporaries, temporary_path, write_atomic, OutputSet,
+    TEMP_MARKER,
+};
+pub(crate) use error::open_message;
+pub use error::{IoError, IoErrorKind};
 pub(crate) use text::as_text;
 pub use text::Tokens;
 
 use crate::mesh::{MeshData, TetMesh};
-use std::fmt;
 use std::fs::File;
-use std::io::{BufWriter, Write};
-use std::path::{Path, PathBuf};
-
-/// A file that could not be read or written, with the place and the problem.
-#[derive(Debug, Clone, PartialEq)]
-pub struct IoError {
-    /// The file.
-    pub path: PathBuf,
-    /// 1-based line, when the problem has one.
-    pub line: Option<usize>,
-    /// What is wrong, in one sentence.
-    pub message: String,
-}
-
-impl IoError {
-    /// An error at a line of a file.
-    pub fn at(path: &Path, line: usize, message: impl Into<String>) -> IoError {
-        IoError {
-            path: path.to_path_buf(),
-            line: Some(line),
-            message: message.into(),
-        }
-    }
-
-    /// An error about a whole file.
-    pub fn file(path: &Path, message: impl Into<String>) -> IoError {
-        IoError {
-            path: path.to_path_buf(),
-            line: None,
-            message: message.into(),
-        }
-    }
-}
-
-impl fmt::Display for IoError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self.line {
-            Some(l) => write!(f, "{}:{}: {}", self.path.display(), l, self.message),
-            None => write!(f, "{}: {}", self.path.display(), self.message),
-        }
-    }
-}
-
-impl std::error::Error for IoError {}
+use std::path::Path;
 
 /// The mesh formats this crate reads and writes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -102,10 +66,10 @@ impl Format {
                 let mut head = Vec::with_capacity(4096);
                 {
                     use std::io::Read;
-                    let f = File::open(path).map_err(|e| IoError::file(path, open_message(&e)))?;
+                    let f = File::open(path).map_err(|e| IoError::os(path, None, e))?;
                     f.take(4096)
                         .read_to_end(&mut head)
-                        .map_err(|e| IoError::file(path, e.to_string()))?;
+                        .map_err(|e| IoError::os(path, None, e))?;
                 }
                 // The first word outside GiD's `#` comment lines.
                 let text = String::from_utf8_lossy(&head);
@@ -147,22 +111,58 @@ impl Format {
     }
 }
 
-/// A readable sentence for a failed open.
-pub(crate) fn open_message(e: &std::io::Error) -> String {
-    match e.kind() {
-        std::io::ErrorKind::NotFound => "no such file".to_string(),
-        std::io::ErrorKind::PermissionDenied => "permission denied".to_string(),
-        _ => e.to_string(),
-    }
-}
-
 /// Reads the whole file, with a clear error.
 pub(crate) fn read_bytes(path: &Path) -> Result<Vec<u8>, IoError> {
-    std::fs::read(path).map_err(|e| IoError::file(path, open_message(&e)))
+    std::fs::read(path).map_err(|e| IoError::os(path, None, e))
 }
 
 /// Reads a mesh, choosing the format by extension.
+///
+/// A file that is not a regular file (a named pipe, `/dev/stdin`) is read
+/// once into a private temporary copy, which the reader then reads (and
+/// sniffs, for `.msh`); errors still name `path`.
 pub fn read_mesh(path: &Path) -> Result<MeshData, IoError> {
+    let meta = std::fs::metadata(path).map_err(|e| IoError::os(path, None, e))?;
+    if meta.is_dir() {
+        return Err(IoError::file(path, "is a directory, not a mesh file"));
+    }
+    if !meta.is_file() {
+        return spooled(path, read_mesh_file);
+    }
+    read_mesh_file(path)
+}
+
+/// Copies the stream `path` once into a temporary regular file with the
+/// same extension, runs `read` on it and names `path` in its errors.
+pub(crate) fn spooled<T>(
+    path: &Path,
+    read: impl FnOnce(&Path) -> Result<T, IoError>,
+) -> Result<T, IoError> {
+    let bytes = read_bytes(path)?;
+    let ext = path
+        .extension()
+        .map(|e| e.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let dir = std::env::temp_dir();
+    let copy = dir.join(format!(
+        "tetrefine-input{TEMP_MARKER}{}-{}.{ext}",
+        std::process::id(),
+        SPOOL.fetch_add(1, std::sync::atomic::Ordering::Relaxed)
+    ));
+    std::fs::write(&copy, &bytes).map_err(|e| IoError::os(&copy, Some("cannot copy a piped input"), e))?;
+    let r = read(&copy);
+    let _ = std::fs::remove_file(&copy);
+    r.map_err(|mut e| {
+        if e.path == copy {
+            e.path = path.to_path_buf();
+        }
+        e
+    })
+}
+
+static SPOOL: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+
+fn read_mesh_file(path: &Path) -> Result<MeshData, IoError> {
     match Format::for_reading(path)? {
         Format::Medit => medit::read(path),
         Format::Gmsh => gmsh::read(path),
@@ -175,11 +175,7 @@ pub fn read_mesh(path: &Path) -> Result<MeshData, IoError> {
 /// Reads a mesh and builds the store; build errors name the file and line.
 pub fn load_mesh(path: &Path) -> Result<(TetMesh, crate::mesh::BuildReport), IoError> {
     let data = read_mesh(path)?;
-    TetMesh::from_data(&data).map_err(|e| IoError {
-        path: path.to_path_buf(),
-        line: e.line().map(|l| l as usize),
-        message: e.to_string(),
-    })
+    TetMesh::from_data(&data).map_err(|e| IoError::mesh(path, e))
 }
 
 /// Writes `mesh` in the format given by the extension of `path`.
@@ -187,7 +183,7 @@ pub fn write_mesh(path: &Path, mesh: &TetMesh) -> Result<(), IoError> {
     match Format::for_writing(path)? {
         Format::Medit => medit::write(path, mesh),
         Format::Gmsh => gmsh::write(path, mesh),
-        Format::Vtu => vtk::write_vtu(path, mesh, &[]),
+        Format::Vtu => vtk::write_vtu(path, mesh, None, &[]),
         Format::Tetgen => tetgen::write(path, mesh),
         Format::Gid => Err(IoError::file(path, "writing GiD is not supported")),
     }
@@ -241,33 +237,4 @@ pub(crate) fn drop_unused_points(d: &mut MeshData) {
     d.corners.iter_mut().for_each(map);
     d.required_vertices.iter_mut().for_each(map);
     d.points = points;
-}
-
-/// Writes through a temporary file beside `path` and renames it into place,
-/// so that a failure (or a crash) never leaves a partial output file.
-pub fn write_atomic(
-    path: &Path,
-    body: impl FnOnce(&mut BufWriter<File>) -> std::io::Result<()>,
-) -> Result<(), IoError> {
-    let dir = path
-        .parent()
-        .filter(|p| !p.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_else(|| "out".into());
-    let tmp = dir.join(format!(".{name}.{}.tmp", std::process::id()));
-    let result = (|| {
-        let f = File::create(&tmp)?;
-        let mut w = BufWriter::with_capacity(1 << 20, f);
-        body(&mut w)?;
-        w.flush()?;
-        w.into_inner().map_err(|e| e.into_error())?.sync_all()?;
-        std::fs::rename(&tmp, path)
-    })();
-    result.map_err(|e| {
-        let _ = std::fs::remove_file(&tmp);
-        IoError::file(path, format!("cannot write: {}", open_message(&e)))
-    })
 }
