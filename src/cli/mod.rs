@@ -3,8 +3,10 @@
 
 pub mod bisect;
 pub mod convert;
+pub mod guard;
 pub mod improve;
 pub mod mesh;
+pub mod outputs;
 pub mod progress;
 pub mod quality;
 pub mod refine;
@@ -16,14 +18,13 @@ use tetrefine::report::histogram::{write_histogram as write_hist_file, Histogram
 use tetrefine::report::MeshStats;
 use tetrefine::TetMesh;
 
-/// `println!` that ignores a closed pipe (`tetrefine quality … | head`):
-/// standard output is a courtesy, the files are the product, and a reader
-/// that stopped early must not turn into a panic.
+/// `println!` that never panics: a failed write (a closed pipe, a full
+/// disk) is remembered and fails the command at its end, so that no output
+/// file appears and the exit status is non-zero.
 #[macro_export]
 macro_rules! say {
     ($($arg:tt)*) => {{
-        use std::io::Write as _;
-        let _ = writeln!(std::io::stdout().lock(), $($arg)*);
+        $crate::cli::outputs::say_line(format_args!($($arg)*));
     }};
 }
 
@@ -32,7 +33,10 @@ pub type CliResult = Result<(), String>;
 
 /// Loads a mesh, telling the user on stderr what building changed.
 pub fn load(path: &std::path::Path) -> Result<tetrefine::TetMesh, String> {
-    let (mesh, report) = tetrefine::io::load_mesh(path).map_err(|e| e.to_string())?;
+    let (mesh, report, notes) = tetrefine::io::load_mesh_noted(path).map_err(|e| e.to_string())?;
+    for n in notes {
+        eprintln!("note: {}: {n}", path.display());
+    }
     if report.reoriented > 0 {
         eprintln!(
             "note: {}: {} tetrahedra were negatively oriented and have been turned around",

@@ -122,6 +122,13 @@ pub(crate) fn read_bytes(path: &Path) -> Result<Vec<u8>, IoError> {
 /// once into a private temporary copy, which the reader then reads (and
 /// sniffs, for `.msh`); errors still name `path`.
 pub fn read_mesh(path: &Path) -> Result<MeshData, IoError> {
+    read_mesh_noted(path).map(|(d, _)| d)
+}
+
+/// [`read_mesh`], and the reader's notes on what it dropped (cells of a
+/// mixed-cell `.vtu` other than tetrahedra and triangles, say), one
+/// sentence each.
+pub fn read_mesh_noted(path: &Path) -> Result<(MeshData, Vec<String>), IoError> {
     let meta = std::fs::metadata(path).map_err(|e| IoError::os(path, None, e))?;
     if meta.is_dir() {
         return Err(IoError::file(path, "is a directory, not a mesh file"));
@@ -162,20 +169,29 @@ pub(crate) fn spooled<T>(
 
 static SPOOL: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
 
-fn read_mesh_file(path: &Path) -> Result<MeshData, IoError> {
+fn read_mesh_file(path: &Path) -> Result<(MeshData, Vec<String>), IoError> {
+    let plain = |d: MeshData| (d, Vec::new());
     match Format::for_reading(path)? {
-        Format::Medit => medit::read(path),
-        Format::Gmsh => gmsh::read(path),
-        Format::Gid => gid::read(path),
-        Format::Vtu => vtk::read(path),
-        Format::Tetgen => tetgen::read(path),
+        Format::Medit => medit::read(path).map(plain),
+        Format::Gmsh => gmsh::read(path).map(plain),
+        Format::Gid => gid::read(path).map(plain),
+        Format::Vtu => vtk::read_noted(path).map(|(d, n)| (d, n.into_iter().collect())),
+        Format::Tetgen => tetgen::read(path).map(plain),
     }
 }
 
 /// Reads a mesh and builds the store; build errors name the file and line.
 pub fn load_mesh(path: &Path) -> Result<(TetMesh, crate::mesh::BuildReport), IoError> {
-    let data = read_mesh(path)?;
-    TetMesh::from_data(&data).map_err(|e| IoError::mesh(path, e))
+    load_mesh_noted(path).map(|(m, r, _)| (m, r))
+}
+
+/// [`load_mesh`], and the reader's notes (see [`read_mesh_noted`]).
+pub fn load_mesh_noted(
+    path: &Path,
+) -> Result<(TetMesh, crate::mesh::BuildReport, Vec<String>), IoError> {
+    let (data, notes) = read_mesh_noted(path)?;
+    let (mesh, report) = TetMesh::from_data(&data).map_err(|e| IoError::mesh(path, e))?;
+    Ok((mesh, report, notes))
 }
 
 /// Writes `mesh` in the format given by the extension of `path`.

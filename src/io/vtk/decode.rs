@@ -119,8 +119,13 @@ impl Layout<'_> {
     }
 
     /// The array bytes after the header (decompressed), from a stream that
-    /// starts with the header.
-    fn unpack(&self, s: &[u8], err: &dyn Fn(&str) -> IoError) -> Result<Vec<u8>, IoError> {
+    /// starts with the header, and the number of stream bytes the array
+    /// takes (header included).
+    fn unpack(
+        &self,
+        s: &[u8],
+        err: &dyn Fn(&str) -> IoError,
+    ) -> Result<(Vec<u8>, usize), IoError> {
         let h = if self.header64 { 8 } else { 4 };
         let word = |i: usize| -> Result<u64, IoError> {
             s.get(i * h..(i + 1) * h)
@@ -131,7 +136,7 @@ impl Layout<'_> {
             let n = word(0)? as usize;
             return s
                 .get(h..h.saturating_add(n))
-                .map(|d| d.to_vec())
+                .map(|d| (d.to_vec(), h + n))
                 .ok_or_else(|| {
                     err(&format!(
                         "array announces {n} bytes but fewer follow (truncated?)"
@@ -141,6 +146,11 @@ impl Layout<'_> {
         let blocks = word(0)? as usize;
         let block = word(1)? as usize;
         let last = word(2)? as usize;
+        if blocks > 0 && (block == 0 || last > block) {
+            return Err(err(&format!(
+                "compressed array header gives blocks of {block} bytes and a last block of {last} (corrupt header)"
+            )));
+        }
         if blocks > s.len() / h {
             return Err(err(&format!(
                 "{blocks} compressed blocks cannot fit the data (corrupt header)"
@@ -187,7 +197,40 @@ impl Layout<'_> {
             }
             at += cs;
         }
-        Ok(out)
+        Ok((out, at))
+    }
+
+    /// The number of bytes the raw appended array at the start of `s` takes,
+    /// header included, from its header alone.
+    pub(super) fn raw_extent(&self, s: &[u8]) -> Result<usize, String> {
+        let h = if self.header64 { 8 } else { 4 };
+        let word = |i: usize| -> Result<u64, String> {
+            s.get(i * h..(i + 1) * h)
+                .map(|w| self.uint(w))
+                .ok_or_else(|| "the appended data ends inside its header (truncated?)".to_string())
+        };
+        let total = if self.compressed {
+            let blocks = word(0)?;
+            if blocks > (s.len() / h) as u64 {
+                return Err(format!(
+                    "its header announces {blocks} compressed blocks, more than the data can hold"
+                ));
+            }
+            let mut t = (3 + blocks) * h as u64;
+            for i in 0..blocks as usize {
+                t = t.saturating_add(word(3 + i)?);
+            }
+            t
+        } else {
+            (h as u64).saturating_add(word(0)?)
+        };
+        if total > s.len() as u64 {
+            return Err(format!(
+                "its header announces {total} bytes but only {} are left in the appended data (truncated or corrupt)",
+                s.len()
+            ));
+        }
+        Ok(total as usize)
     }
 
     /// Values of a DataArray element.
@@ -241,7 +284,14 @@ impl Layout<'_> {
             "binary" => {
                 let bytes =
                     base64_pieces(e.text.as_bytes()).ok_or_else(|| err("invalid base64 data"))?;
-                self.unpack(&bytes, &err)?
+                let (raw, used) = self.unpack(&bytes, &err)?;
+                if used != bytes.len() {
+                    return Err(err(&format!(
+                        "its header announces {used} bytes but the element holds {} (corrupt header or data)",
+                        bytes.len()
+                    )));
+                }
+                raw
             }
             "appended" => {
                 let app = self
@@ -260,9 +310,9 @@ impl Layout<'_> {
                     let end = s.iter().position(|&c| c == b'<').unwrap_or(s.len());
                     let bytes =
                         base64_pieces(&s[..end]).ok_or_else(|| err("invalid base64 data"))?;
-                    self.unpack(&bytes, &err)?
+                    self.unpack(&bytes, &err)?.0
                 } else {
-                    self.unpack(s, &err)?
+                    self.unpack(s, &err)?.0
                 }
             }
             other => return Err(err(&format!("unknown format '{other}'"))),

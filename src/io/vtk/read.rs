@@ -6,14 +6,52 @@ use super::VTK_TETRA;
 use crate::io::{read_bytes, IoError};
 use crate::mesh::MeshData;
 use std::borrow::Cow;
+use std::collections::BTreeMap;
 use std::path::Path;
 
-/// Reads a `.vtu` file: its tetrahedra, points and regions.
+/// Reads a `.vtu` file: its tetrahedra, boundary triangles, points and
+/// regions. Cells of other types are dropped ([`read_noted`] says which).
 pub fn read(path: &Path) -> Result<MeshData, IoError> {
+    read_noted(path).map(|(d, _)| d)
+}
+
+/// VTK's cell type of a linear triangle.
+const VTK_TRIANGLE: i64 = 5;
+
+/// The number of points of VTK cell type `ty`: `None` if the type is not
+/// VTK's, `Some(None)` if its cells have any number of points.
+fn cell_size(ty: i64) -> Option<Option<i64>> {
+    Some(match ty {
+        1 => Some(1),
+        3 | 21 => Some(if ty == 3 { 2 } else { 3 }),
+        5 => Some(3),
+        8 | 9 | 10 | 35 => Some(4),
+        14 => Some(5),
+        13 | 22 | 30 => Some(6),
+        34 => Some(7),
+        11 | 12 | 23 => Some(8),
+        28 => Some(9),
+        15 | 24 => Some(10),
+        16 | 31 => Some(12),
+        27 => Some(13),
+        26 => Some(15),
+        32 | 33 => Some(18),
+        37 => Some(19),
+        25 => Some(20),
+        29 => Some(27),
+        2 | 4 | 6 | 7 | 36 | 41 | 42 | 51..=56 | 60..=81 => None,
+        _ => return None,
+    })
+}
+
+/// [`read`], and a note on what was dropped (cells other than tetrahedra
+/// and triangles, by VTK type), if anything was.
+pub fn read_noted(path: &Path) -> Result<(MeshData, Option<String>), IoError> {
     with_pieces(path, |layout, elems, pieces| {
         let mut data = MeshData::default();
         let mut any_region = false;
         let mut regions: Vec<i32> = Vec::new();
+        let mut dropped = BTreeMap::new();
         for piece in pieces {
             read_piece(
                 path,
@@ -23,8 +61,21 @@ pub fn read(path: &Path) -> Result<MeshData, IoError> {
                 &mut data,
                 &mut regions,
                 &mut any_region,
+                &mut dropped,
             )?;
         }
+        let note = (!dropped.is_empty()).then(|| {
+            let kinds: Vec<String> = dropped
+                .iter()
+                .map(|(ty, n)| format!("{n} of VTK type {ty}"))
+                .collect();
+            format!(
+                "kept {} tetrahedra and {} triangles; dropped the other cells ({})",
+                data.tets.len(),
+                data.triangles.len(),
+                kinds.join(", ")
+            )
+        });
         if data.tets.is_empty() {
             return Err(IoError::file(
                 path,
@@ -34,7 +85,7 @@ pub fn read(path: &Path) -> Result<MeshData, IoError> {
         if any_region {
             data.tet_regions = regions;
         }
-        Ok(data)
+        Ok((data, note))
     })
 }
 
@@ -67,7 +118,16 @@ fn with_pieces<R>(
                 .ok_or_else(|| {
                     IoError::file(path, "AppendedData without its '_' marker (truncated?)")
                 })?;
-            (&bytes[..at], Some(&bytes[under..]), base64)
+            // The data ends where the element closes (the last closing tag:
+            // raw bytes may happen to spell it earlier).
+            let data = &bytes[under..];
+            let end = rfind(data, b"</AppendedData>").ok_or_else(|| {
+                IoError::file(
+                    path,
+                    "<AppendedData> is never closed by </AppendedData> (truncated?)",
+                )
+            })?;
+            (&bytes[..at], Some(&data[..end]), base64)
         }
         None => (&bytes[..], None, false),
     };
@@ -120,14 +180,41 @@ fn with_pieces<R>(
             ))
         }
     };
+    let big_endian = match root.attr("byte_order") {
+        None | Some("LittleEndian") => false,
+        Some("BigEndian") => true,
+        Some(other) => {
+            return Err(IoError::at(
+                path,
+                root.line,
+                format!("byte_order '{other}' is neither LittleEndian nor BigEndian"),
+            ))
+        }
+    };
+    let header64 = match root.attr("header_type") {
+        None | Some("UInt32") => false,
+        Some("UInt64") => true,
+        Some(other) => {
+            return Err(IoError::at(
+                path,
+                root.line,
+                format!("header_type '{other}' is neither UInt32 nor UInt64"),
+            ))
+        }
+    };
     let layout = Layout {
         path,
-        big_endian: root.attr("byte_order") == Some("BigEndian"),
-        header64: root.attr("header_type") == Some("UInt64"),
+        big_endian,
+        header64,
         compressed,
         appended,
         appended_base64,
     };
+    if !appended_base64 {
+        if let Some(data) = appended {
+            check_appended_blocks(&layout, &elems, data)?;
+        }
+    }
     let child = |e: &Element, name: &str| {
         e.children
             .iter()
@@ -269,6 +356,69 @@ fn find(hay: &[u8], needle: &[u8]) -> Option<usize> {
     hay.windows(needle.len()).position(|w| w == needle)
 }
 
+fn rfind(hay: &[u8], needle: &[u8]) -> Option<usize> {
+    hay.windows(needle.len()).rposition(|w| w == needle)
+}
+
+/// Checks that the raw appended arrays tile the appended data: each array's
+/// block (header and data, by its header) ends exactly where the next array
+/// (by offset) starts, and the last one where the data ends (whitespace
+/// aside). A line duplicated or cut inside the data breaks this, and the
+/// error names the first array whose block does not fit.
+fn check_appended_blocks(layout: &Layout, elems: &[Element], data: &[u8]) -> Result<(), IoError> {
+    let path = layout.path;
+    let mut arrays: Vec<(usize, &Element)> = Vec::new();
+    for e in elems
+        .iter()
+        .filter(|e| e.name == "DataArray" && e.attr("format") == Some("appended"))
+    {
+        let name = e.attr("Name").unwrap_or("");
+        let off = e
+            .attr("offset")
+            .and_then(|s| s.trim().parse::<usize>().ok())
+            .ok_or_else(|| {
+                IoError::at(
+                    path,
+                    e.line,
+                    format!("DataArray '{name}': appended array without a valid offset"),
+                )
+            })?;
+        arrays.push((off, e));
+    }
+    arrays.sort_by_key(|&(off, e)| (off, e.line));
+    let end_of_data = data
+        .iter()
+        .rposition(|c| !c.is_ascii_whitespace())
+        .map_or(0, |i| i + 1);
+    for (i, &(off, e)) in arrays.iter().enumerate() {
+        let name = e.attr("Name").unwrap_or("");
+        let err = |m: String| IoError::at(path, e.line, format!("DataArray '{name}': {m}"));
+        let rest = data.get(off..).ok_or_else(|| {
+            err(format!(
+                "offset {off} is past the end of the {} bytes of appended data (truncated?)",
+                data.len()
+            ))
+        })?;
+        let extent = layout.raw_extent(rest).map_err(&err)?;
+        let end = off + extent;
+        match arrays.get(i + 1) {
+            Some(&(next, ne)) if end != next => {
+                let next_name = ne.attr("Name").unwrap_or("");
+                return Err(err(format!(
+                    "its appended block (offset {off}, {extent} bytes by its header) ends at byte {end}, but the next array '{next_name}' starts at {next}: the appended data is corrupt"
+                )));
+            }
+            None if end < end_of_data => {
+                return Err(err(format!(
+                    "its appended block, the last one, ends at byte {end} but the appended data holds {end_of_data} bytes: the appended data is corrupt (a duplicated or inserted line?)"
+                )));
+            }
+            _ => {}
+        }
+    }
+    Ok(())
+}
+
 fn count_attr(path: &Path, e: &Element, key: &str) -> Result<usize, IoError> {
     let s = e
         .attr(key)
@@ -278,6 +428,7 @@ fn count_attr(path: &Path, e: &Element, key: &str) -> Result<usize, IoError> {
         .map_err(|_| IoError::at(path, e.line, format!("{key}=\"{s}\" is not a valid count")))
 }
 
+#[allow(clippy::too_many_arguments)] // one piece's inputs and the accumulators
 fn read_piece(
     path: &Path,
     layout: &Layout,
@@ -286,6 +437,7 @@ fn read_piece(
     data: &mut MeshData,
     regions: &mut Vec<i32>,
     any_region: &mut bool,
+    dropped: &mut BTreeMap<i64, usize>,
 ) -> Result<(), IoError> {
     let np = count_attr(path, piece, "NumberOfPoints")?;
     let nc = count_attr(path, piece, "NumberOfCells")?;
@@ -403,6 +555,22 @@ fn read_piece(
         *any_region = true;
     }
 
+    if let Some(&last) = offsets.last() {
+        if last as u64 != conn.len() as u64 {
+            return Err(at(
+                off_e,
+                format!(
+                    "the last offset is {last} but the connectivity holds {} entries",
+                    conn.len()
+                ),
+            ));
+        }
+    } else if !conn.is_empty() {
+        return Err(at(
+            conn_e,
+            format!("{} connectivity entries for no cells", conn.len()),
+        ));
+    }
     let mut start = 0i64;
     for (c, (&end, &ty)) in offsets.iter().zip(&types).enumerate() {
         if end < start || end as u64 > conn.len() as u64 {
@@ -415,30 +583,43 @@ fn read_piece(
                 ),
             ));
         }
+        let n = end - start;
+        let size = cell_size(ty).ok_or_else(|| {
+            at(
+                typ_e,
+                format!("cell {} has type {ty}, which is not a VTK cell type", c + 1),
+            )
+        })?;
+        if size.is_some_and(|k| k != n) {
+            return Err(at(
+                conn_e,
+                format!(
+                    "cell {} (VTK type {ty}) has {n} points; that type has {}",
+                    c + 1,
+                    size.unwrap_or(0)
+                ),
+            ));
+        }
+        let ids = &conn[start as usize..end as usize];
+        if let Some(&i) = ids.iter().find(|&&i| i < 0 || i as u64 >= np as u64) {
+            return Err(at(
+                conn_e,
+                format!(
+                    "cell {} refers to point {i} but the piece has {np} points (0-based)",
+                    c + 1
+                ),
+            ));
+        }
+        let id = |k: usize| (base + ids[k]) as u32;
         if ty == VTK_TETRA as i64 {
-            if end - start != 4 {
-                return Err(at(
-                    conn_e,
-                    format!("tetrahedron (cell {}) has {} points", c + 1, end - start),
-                ));
-            }
-            let mut v = [0u32; 4];
-            for (k, slot) in v.iter_mut().enumerate() {
-                let i = conn[start as usize + k];
-                if i < 0 || i as u64 >= np as u64 {
-                    return Err(at(
-                        conn_e,
-                        format!(
-                            "cell {} refers to point {i} but the piece has {np} points (0-based)",
-                            c + 1
-                        ),
-                    ));
-                }
-                *slot = (base + i) as u32;
-            }
-            data.tets.push(v);
+            data.tets.push([id(0), id(1), id(2), id(3)]);
             data.tet_lines.push(conn_e.line as u32);
             regions.push(region_values.as_ref().map_or(0, |r| r[c]));
+        } else if ty == VTK_TRIANGLE {
+            data.triangles
+                .push(([id(0), id(1), id(2)], region_values.as_ref().map_or(0, |r| r[c])));
+        } else {
+            *dropped.entry(ty).or_default() += 1;
         }
         start = end;
     }
