@@ -91,12 +91,19 @@ impl MemoryBudget {
     /// `tets + (TETS_PER_SPLIT_TET − 1)·split` tets, each costing
     /// [`PEAK_BYTES_PER_OUTPUT_TET`] at the peak, beside `kept_tets` tets of
     /// meshes held besides.
-    pub fn check_step(&self, step: usize, tets: u64, split: u64, kept_tets: u64) -> Result<(), String> {
+    pub fn check_step(
+        &self,
+        step: usize,
+        tets: u64,
+        split: u64,
+        kept_tets: u64,
+    ) -> Result<(), String> {
         let Some(limit) = self.limit else {
             return Ok(());
         };
         let out = tets as f64 + (TETS_PER_SPLIT_TET - 1.0) * split as f64;
-        let need = out * PEAK_BYTES_PER_OUTPUT_TET as f64 + (kept_tets * STORE_BYTES_PER_TET) as f64;
+        let need =
+            out * PEAK_BYTES_PER_OUTPUT_TET as f64 + (kept_tets * STORE_BYTES_PER_TET) as f64;
         if need > limit as f64 {
             return Err(format!(
                 "step {step} would not fit in memory: about {:.3e} output tets need about {} at the peak ({} bytes per output tet, measured), but {} allows {}; ask for fewer steps or a smaller selection, or set --max-memory",
@@ -113,7 +120,13 @@ impl MemoryBudget {
     /// Projects `steps` steps from a mesh of `tets` tets with `split` of them
     /// selected (each later step splits the descendants: × the step ratio),
     /// and refuses at the first step that would not fit, before any work.
-    pub fn check_plan(&self, steps: usize, tets: u64, split: u64, kept_tets: u64) -> Result<(), String> {
+    pub fn check_plan(
+        &self,
+        steps: usize,
+        tets: u64,
+        split: u64,
+        kept_tets: u64,
+    ) -> Result<(), String> {
         let (mut n, mut s) = (tets as f64, split as f64);
         for step in 1..=steps {
             if n > 1e18 {
@@ -148,7 +161,10 @@ pub fn check_selection(strategy: &MarkStrategy, mesh: &TetMesh) -> Result<(), St
             match ids.iter().find(|i| have.binary_search(i).is_err()) {
                 Some(i) => Err(format!(
                     "--mark {strategy}: the mesh has no region {i} (its regions are {})",
-                    have.iter().map(|r| r.to_string()).collect::<Vec<_>>().join(", ")
+                    have.iter()
+                        .map(|r| r.to_string())
+                        .collect::<Vec<_>>()
+                        .join(", ")
                 )),
                 None => Ok(()),
             }

@@ -106,8 +106,7 @@ pub fn write_refined(
         );
         let (valence, stats) = (MeshStats::vertex_valence(mesh), MeshStats::compute(mesh));
         let summary = vtu_summary(&valence, &stats);
-        tetrefine::io::vtk::write_vtu(path, mesh, Some(&summary), &cells)
-            .map_err(|e| e.to_string())
+        tetrefine::io::vtk::write_vtu(path, mesh, Some(&summary), &cells).map_err(|e| e.to_string())
     } else {
         tetrefine::io::write_mesh(path, mesh).map_err(|e| e.to_string())
     }

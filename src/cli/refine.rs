@@ -206,7 +206,12 @@ pub fn run(a: Args) -> super::CliResult {
     let selected = selection
         .as_ref()
         .map_or(input.n_tets(), |s| s.iter().filter(|&&x| x).count()) as u64;
-    budget.check_plan(a.steps, input.n_tets() as u64, selected, input.n_tets() as u64)?;
+    budget.check_plan(
+        a.steps,
+        input.n_tets() as u64,
+        selected,
+        input.n_tets() as u64,
+    )?;
     super::apply_feature_option(&mut input, &a.features, a.feature_angle)?;
     let mut mesh = input.clone();
     let mut opts = RefineOptions {

@@ -18,12 +18,12 @@
 //! no longer run (see [`remove_stale_temporaries`]).
 
 use super::IoError;
+use std::cell::RefCell;
 use std::ffi::CString;
 use std::fs::File;
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, AtomicPtr, Ordering};
-use std::cell::RefCell;
 
 /// The marker in every temporary file name: `.NAME.tetrefine-PID.tmp`.
 pub const TEMP_MARKER: &str = ".tetrefine-";
@@ -101,7 +101,10 @@ pub fn install_signal_cleanup() {
     for sig in [libc::SIGINT, libc::SIGTERM, libc::SIGHUP] {
         // SAFETY: `on_signal` only performs async-signal-safe calls.
         unsafe {
-            libc::signal(sig, on_signal as extern "C" fn(libc::c_int) as libc::sighandler_t);
+            libc::signal(
+                sig,
+                on_signal as extern "C" fn(libc::c_int) as libc::sighandler_t,
+            );
         }
     }
 }

@@ -156,7 +156,8 @@ pub(crate) fn spooled<T>(
         std::process::id(),
         SPOOL.fetch_add(1, std::sync::atomic::Ordering::Relaxed)
     ));
-    std::fs::write(&copy, &bytes).map_err(|e| IoError::os(&copy, Some("cannot copy a piped input"), e))?;
+    std::fs::write(&copy, &bytes)
+        .map_err(|e| IoError::os(&copy, Some("cannot copy a piped input"), e))?;
     let r = read(&copy);
     let _ = std::fs::remove_file(&copy);
     r.map_err(|mut e| {

@@ -113,6 +113,24 @@ pub enum PlcError {
         /// 1-based facet number.
         facet: usize,
     },
+    /// A region seed lies in no bounded cell: outside the surface.
+    #[error("region {index} has its seed at {coords:?}, outside the surface: a region seed must lie inside the volume (TetGen crashes on it)")]
+    SeedOutside {
+        /// 1-based region number.
+        index: usize,
+        /// The seed.
+        coords: [f64; 3],
+    },
+    /// A region seed lies in a cell that a hole seed empties.
+    #[error(
+        "region {index} has its seed in the cell that hole {hole} empties: the region would vanish"
+    )]
+    SeedInHole {
+        /// 1-based region number.
+        index: usize,
+        /// 1-based number of the hole seed of the same cell.
+        hole: usize,
+    },
     /// The facets do not split space into cells consistently.
     #[error("the facets do not enclose volumes consistently ({0}); do they intersect?")]
     Inconsistent(String),

@@ -14,17 +14,23 @@ pub(super) struct Analysis {
     pub(super) center: DVec3,
     pub(super) facets: Vec<FacetGeom>,
     pub(super) pieces: Vec<Piece>,
+    /// The bounding box of the surface's points (input coordinates).
+    pub(super) lo: DVec3,
+    /// Its largest corner.
+    pub(super) hi: DVec3,
     /// Distance tolerance for degenerate ray hits.
     pub(super) tol: f64,
 }
 
 impl Analysis {
     pub(super) fn run(plc: &Plc) -> Result<PlcVolume, PlcError> {
-        let (pts, center, canon, diag) = check_points(plc)?;
+        let (pts, center, canon, diag, (lo, hi)) = check_points(plc)?;
         let tol = 1e-9 * diag;
         let mut a = Analysis {
             pts,
             center,
+            lo,
+            hi,
             facets: Vec::with_capacity(plc.facets.len()),
             pieces: Vec::new(),
             tol,
@@ -196,7 +202,8 @@ impl Analysis {
 /// Checks coordinates, seeds, extent and coplanarity. Returns the points
 /// centred on the bounding box of the surface, the centre, the map to
 /// canonical (first coincident) points and the bounding box diagonal.
-fn check_points(plc: &Plc) -> Result<(Vec<DVec3>, DVec3, Vec<u32>, f64), PlcError> {
+#[allow(clippy::type_complexity)] // a private helper's several results
+fn check_points(plc: &Plc) -> Result<(Vec<DVec3>, DVec3, Vec<u32>, f64, (DVec3, DVec3)), PlcError> {
     if let Some((i, p)) = plc
         .points
         .iter()
@@ -281,7 +288,7 @@ fn check_points(plc: &Plc) -> Result<(Vec<DVec3>, DVec3, Vec<u32>, f64), PlcErro
         .iter()
         .map(|p| DVec3::from_array(*p) - center)
         .collect();
-    Ok((pts, center, canon, diag))
+    Ok((pts, center, canon, diag, (lo, hi)))
 }
 
 /// Whether some four of the points span a volume, with exact predicates.
@@ -507,7 +514,10 @@ impl Analysis {
     /// Candidate pairs come from a uniform grid over the pieces' boxes.
     /// Facets that overlap within one plane are found by `glue_sides` only
     /// where they share an edge.
-    pub(super) fn check_intersections(&self, edges: &[([u32; 2], Vec<Incidence>)]) -> Result<(), PlcError> {
+    pub(super) fn check_intersections(
+        &self,
+        edges: &[([u32; 2], Vec<Incidence>)],
+    ) -> Result<(), PlcError> {
         let np = self.pieces.len();
         let lo = self.pieces.iter().fold(DVec3::INFINITY, |a, p| a.min(p.lo));
         let hi = self

@@ -6,6 +6,7 @@ use super::validate::Analysis;
 use super::{Plc, PlcError, PlcVolume};
 use glam::DVec3;
 use std::collections::HashMap;
+use PlcError::SeedOutside;
 
 impl Analysis {
     /// Sorts the pieces around each edge by angle and glues the sides that
@@ -123,7 +124,12 @@ impl Analysis {
     }
 
     /// Groups shells into cells, locates the seeds and adds up the volumes.
-    pub(super) fn cells(&self, plc: &Plc, sides: &mut UnionFind, diag: f64) -> Result<PlcVolume, PlcError> {
+    pub(super) fn cells(
+        &self,
+        plc: &Plc,
+        sides: &mut UnionFind,
+        diag: f64,
+    ) -> Result<PlcVolume, PlcError> {
         let np = self.pieces.len();
         // Shells: components of glued sides, numbered densely.
         let mut shell_of_root: HashMap<u32, usize> = HashMap::new();
@@ -253,17 +259,40 @@ impl Analysis {
         }
         // Hole seeds.
         let mut emptied: Vec<u32> = Vec::new();
+        let mut hole_of_cell: HashMap<u32, usize> = HashMap::new();
         for (i, h) in plc.holes.iter().enumerate() {
             let x = DVec3::from_array(*h) - self.center;
             if let Some(c) = self.locate(x, "hole", i, &shell_of_side, &mut cells)? {
                 if outer_of_cell.contains_key(&c) {
                     emptied.push(c);
+                    hole_of_cell.entry(c).or_insert(i);
                 }
             }
         }
+        // Region seeds: each must lie in a bounded cell that no hole empties.
+        // A seed outside the bounding box of the surface is outside (an
+        // exact comparison: no ray is cast from 1e308).
         for (i, r) in plc.regions.iter().enumerate() {
-            let x = DVec3::from_array(r.point) - self.center;
-            self.locate(x, "region", i, &shell_of_side, &mut cells)?;
+            let outside = SeedOutside {
+                index: i + 1,
+                coords: r.point,
+            };
+            let p = DVec3::from_array(r.point);
+            if (0..3).any(|a| p[a] < self.lo[a] || p[a] > self.hi[a]) {
+                return Err(outside);
+            }
+            let x = p - self.center;
+            match self.locate(x, "region", i, &shell_of_side, &mut cells)? {
+                Some(c) if outer_of_cell.contains_key(&c) => {
+                    if let Some(&h) = hole_of_cell.get(&c) {
+                        return Err(PlcError::SeedInHole {
+                            index: i + 1,
+                            hole: h + 1,
+                        });
+                    }
+                }
+                _ => return Err(outside),
+            }
         }
         emptied.sort_unstable();
         emptied.dedup();

@@ -121,11 +121,7 @@ impl Layout<'_> {
     /// The array bytes after the header (decompressed), from a stream that
     /// starts with the header, and the number of stream bytes the array
     /// takes (header included).
-    fn unpack(
-        &self,
-        s: &[u8],
-        err: &dyn Fn(&str) -> IoError,
-    ) -> Result<(Vec<u8>, usize), IoError> {
+    fn unpack(&self, s: &[u8], err: &dyn Fn(&str) -> IoError) -> Result<(Vec<u8>, usize), IoError> {
         let h = if self.header64 { 8 } else { 4 };
         let word = |i: usize| -> Result<u64, IoError> {
             s.get(i * h..(i + 1) * h)
@@ -374,4 +370,3 @@ impl Layout<'_> {
         Ok((v, comps))
     }
 }
-

@@ -351,7 +351,6 @@ fn read_piece_cell_array(
     Ok(())
 }
 
-
 fn find(hay: &[u8], needle: &[u8]) -> Option<usize> {
     hay.windows(needle.len()).position(|w| w == needle)
 }
@@ -616,8 +615,10 @@ fn read_piece(
             data.tet_lines.push(conn_e.line as u32);
             regions.push(region_values.as_ref().map_or(0, |r| r[c]));
         } else if ty == VTK_TRIANGLE {
-            data.triangles
-                .push(([id(0), id(1), id(2)], region_values.as_ref().map_or(0, |r| r[c])));
+            data.triangles.push((
+                [id(0), id(1), id(2)],
+                region_values.as_ref().map_or(0, |r| r[c]),
+            ));
         } else {
             *dropped.entry(ty).or_default() += 1;
         }
@@ -625,4 +626,3 @@ fn read_piece(
     }
     Ok(())
 }
-

@@ -13,7 +13,6 @@ use std::path::Path;
 /// Uncompressed size of one zlib block (VTK's default).
 const BLOCK: usize = 1 << 15;
 
-
 /// An extra per-tet array for [`write_vtu`]: one value per live tet, in id order.
 pub enum CellArray<'a> {
     /// A 32-bit integer array with its name.
@@ -56,7 +55,6 @@ impl CellArray<'_> {
         }
     }
 }
-
 
 /// What a `.vtu` carries besides the mesh and its per-tet quality arrays:
 /// figures the caller computes (the statistics live outside `io`), written
@@ -321,4 +319,3 @@ pub fn write_vtu(
         )
     })
 }
-

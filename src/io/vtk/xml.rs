@@ -226,7 +226,6 @@ pub(super) fn parse_xml<'a>(path: &Path, text: &'a str) -> Result<Vec<Element<'a
     Ok(elems)
 }
 
-
 /// The first child of `e` with tag `tag`.
 pub(super) fn child_element<'a, 'b>(
     elems: &'a [Element<'b>],
@@ -248,7 +247,6 @@ pub(super) fn data_arrays<'a, 'b>(elems: &'a [Element<'b>], e: &Element) -> Vec<
         .collect()
 }
 
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -266,4 +264,3 @@ mod tests {
         assert_eq!(elems[1].line, 2);
     }
 }
-
