@@ -75,7 +75,12 @@ fn every_duplicated_line_of_the_appended_data_of_mmg_cube_is_an_error_naming_an_
             // byte 10) that reaches the end of the data only appends
             // whitespace: the file is then the same mesh, which is fine.
             Ok(d) => {
-                assert_eq!(b - a, 1, "a duplicated line of {} bytes at {a} passed", b - a);
+                assert_eq!(
+                    b - a,
+                    1,
+                    "a duplicated line of {} bytes at {a} passed",
+                    b - a
+                );
                 assert_eq!(
                     (&d.points, &d.tets, &d.triangles),
                     (&original.points, &original.tets, &original.triangles),
@@ -591,4 +596,161 @@ fn region_seeds_outside_the_domain_or_in_a_hole_are_refused() {
         "{:?}",
         c.validate()
     );
+}
+
+#[test]
+fn surfaces_at_1e300_and_1e_minus_300_are_judged_by_their_shape() {
+    for scale in [1e300, 1e-300, 1e150, 3.0] {
+        let mut c = cube();
+        for p in &mut c.points {
+            *p = p.map(|x| x * scale);
+        }
+        let v = c.analyze().unwrap_or_else(|e| panic!("{scale}: {e}"));
+        assert_eq!(v.cells, 1, "{scale}");
+        let want = scale * scale * scale;
+        if want.is_finite() && want > 0.0 {
+            assert!(
+                (v.enclosed - want).abs() <= 1e-12 * want,
+                "{scale}: {}",
+                v.enclosed
+            );
+        }
+        // Flat at any scale is still flat.
+        let mut flat = c.clone();
+        for p in &mut flat.points {
+            p[2] = 0.0;
+        }
+        assert!(flat.validate().is_err(), "{scale}");
+    }
+}
+
+#[test]
+fn a_non_manifold_boundary_is_accepted_with_a_note_naming_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let write = |name: &str, pts: &[[f64; 3]], tets: &[[u32; 4]]| {
+        let mut s = String::from("MeshVersionFormatted 2\nDimension 3\nVertices\n");
+        s += &format!("{}\n", pts.len());
+        for p in pts {
+            s += &format!("{} {} {} 0\n", p[0], p[1], p[2]);
+        }
+        s += &format!("Tetrahedra\n{}\n", tets.len());
+        for t in tets {
+            s += &format!("{} {} {} {} 1\n", t[0], t[1], t[2], t[3]);
+        }
+        s += "End\n";
+        let p = dir.path().join(name);
+        std::fs::write(&p, s).unwrap();
+        p
+    };
+    // Two tets sharing only the edge 1-2 (1-based), on opposite sides.
+    let edge = write(
+        "edge.mesh",
+        &[
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.0, 0.0, 1.0],
+            [0.0, -1.0, 0.0],
+            [0.0, 0.0, -1.0],
+        ],
+        &[[1, 2, 3, 4], [1, 2, 5, 6]],
+    );
+    // Two tets sharing only vertex 1.
+    let vertex = write(
+        "vertex.mesh",
+        &[
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.0, 0.0, 1.0],
+            [-1.0, 0.0, 0.0],
+            [0.0, -1.0, 0.0],
+            [0.0, 0.0, -1.0],
+        ],
+        &[[1, 2, 3, 4], [1, 5, 6, 7]],
+    );
+    let o = tetrefine(&["quality", edge.to_str().unwrap(), "--json"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let e = stderr(&o);
+    assert!(
+        e.contains("not a manifold") && e.contains("joins vertices 1 and 2"),
+        "{e}"
+    );
+    let o = tetrefine(&["quality", vertex.to_str().unwrap(), "--json"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let e = stderr(&o);
+    assert!(
+        e.contains("not a manifold") && e.contains("the first is vertex 1"),
+        "{e}"
+    );
+    // A manifold mesh gets no such note.
+    let o = tetrefine(&[
+        "quality",
+        meshes().join("tripod.mesh").to_str().unwrap(),
+        "--json",
+    ]);
+    assert!(!stderr(&o).contains("manifold"), "{}", stderr(&o));
+}
+
+#[test]
+fn a_neck_or_cut_so_small_that_points_coincide_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let tet = dir.path().join("tet.obj");
+    std::fs::write(
+        &tet,
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 2 3 4\nf 1 4 3\n",
+    )
+    .unwrap();
+    let cube = dir.path().join("cube.obj");
+    std::fs::write(
+        &cube,
+        "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n\
+f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\n",
+    )
+    .unwrap();
+    let out = dir.path().join("o.obj");
+    let o_ = out.to_str().unwrap();
+    for (scheme, input, opt, v) in [
+        ("sierpinski", &tet, "--neck", "1e-300"),
+        ("sierpinski", &tet, "--neck", "1e-17"),
+        ("truncate", &cube, "--cut", "1e-300"),
+        ("truncate", &cube, "--cut", "1e-17"),
+    ] {
+        let o = tetrefine(&[
+            "surface",
+            scheme,
+            input.to_str().unwrap(),
+            "-o",
+            o_,
+            "--steps",
+            "2",
+            opt,
+            v,
+        ]);
+        assert_eq!(
+            o.status.code(),
+            Some(1),
+            "{scheme} {opt} {v}: {}",
+            stderr(&o)
+        );
+        let e = stderr(&o);
+        assert!(
+            e.contains("coincident") || e.contains("zero area") || e.contains(opt),
+            "{e}"
+        );
+        assert!(!out.exists());
+    }
+    // The defaults are fine.
+    for (scheme, input) in [("sierpinski", &tet), ("truncate", &cube)] {
+        let o = tetrefine(&[
+            "surface",
+            scheme,
+            input.to_str().unwrap(),
+            "-o",
+            o_,
+            "--steps",
+            "2",
+        ]);
+        assert!(o.status.success(), "{scheme}: {}", stderr(&o));
+    }
 }

@@ -185,3 +185,138 @@ pub fn check_selection(strategy: &MarkStrategy, mesh: &TetMesh) -> Result<(), St
         _ => Ok(()),
     }
 }
+
+/// A note naming the non-manifold places of the boundary, if any: edges
+/// with more than two boundary faces (two tets sharing only an edge), and
+/// vertices whose boundary faces form more than one fan (two tets sharing
+/// only a vertex). Such meshes are accepted (solvers can use them), but
+/// boundary rules and feature detection see several surfaces meeting there.
+/// Vertex numbers are 1-based, as in the mesh files.
+pub fn nonmanifold_note(mesh: &TetMesh) -> Option<String> {
+    use std::collections::HashMap;
+    let mut faces: Vec<[u32; 3]> = Vec::new();
+    for t in mesh.tet_ids() {
+        for f in 0..4 {
+            if mesh.is_boundary_face(t, f) {
+                faces.push(mesh.face_vertices(t, f));
+            }
+        }
+    }
+    let mut edge_count: HashMap<[u32; 2], u32> = HashMap::new();
+    for f in &faces {
+        for (a, b) in [(f[0], f[1]), (f[1], f[2]), (f[2], f[0])] {
+            *edge_count.entry([a.min(b), a.max(b)]).or_default() += 1;
+        }
+    }
+    let mut bad_edges: Vec<[u32; 2]> = edge_count
+        .iter()
+        .filter(|(_, &n)| n > 2)
+        .map(|(e, _)| *e)
+        .collect();
+    bad_edges.sort_unstable();
+    // Fans at each vertex: union the boundary faces at v that share an edge at v.
+    let mut at: HashMap<u32, Vec<usize>> = HashMap::new();
+    for (i, f) in faces.iter().enumerate() {
+        for &v in f {
+            at.entry(v).or_default().push(i);
+        }
+    }
+    let mut bad_vertices: Vec<u32> = Vec::new();
+    for (&v, fs) in &at {
+        let mut parent: Vec<usize> = (0..fs.len()).collect();
+        fn find(p: &mut [usize], mut x: usize) -> usize {
+            while p[x] != x {
+                p[x] = p[p[x]];
+                x = p[x];
+            }
+            x
+        }
+        let mut by_edge: HashMap<u32, usize> = HashMap::new();
+        for (k, &fi) in fs.iter().enumerate() {
+            for &w in faces[fi].iter().filter(|&&w| w != v) {
+                if edge_count.get(&[v.min(w), v.max(w)]).copied().unwrap_or(0) > 2 {
+                    continue; // counted as an edge already
+                }
+                match by_edge.get(&w) {
+                    Some(&j) => {
+                        let (a, b) = (find(&mut parent, k), find(&mut parent, j));
+                        parent[a.max(b)] = a.min(b);
+                    }
+                    None => {
+                        by_edge.insert(w, k);
+                    }
+                }
+            }
+        }
+        let fans = (0..fs.len()).filter(|&k| find(&mut parent, k) == k).count();
+        let on_bad_edge = bad_edges.iter().any(|e| e.contains(&v));
+        if fans > 1 && !on_bad_edge {
+            bad_vertices.push(v);
+        }
+    }
+    bad_vertices.sort_unstable();
+    if bad_edges.is_empty() && bad_vertices.is_empty() {
+        return None;
+    }
+    let mut parts = Vec::new();
+    if let Some(e) = bad_edges.first() {
+        parts.push(format!(
+            "{} boundary edges where more than two boundary faces meet (the first joins vertices {} and {})",
+            bad_edges.len(),
+            e[0] + 1,
+            e[1] + 1
+        ));
+    }
+    if let Some(v) = bad_vertices.first() {
+        parts.push(format!(
+            "{} boundary vertices where separate parts of the boundary touch (the first is vertex {})",
+            bad_vertices.len(),
+            v + 1
+        ));
+    }
+    Some(format!(
+        "the boundary is not a manifold: {}; accepted as is",
+        parts.join(", and ")
+    ))
+}
+
+/// Refuses a subdivided surface with coincident points or zero-area faces
+/// (a `--neck` or `--cut` so small, or so many steps, that the new points
+/// round onto old ones): no solver or viewer wants such a file.
+pub fn check_surface_output(mesh: &tetrefine::surface::PolyMesh, what: &str) -> Result<(), String> {
+    use std::collections::HashMap;
+    let mut used = vec![false; mesh.points.len()];
+    for f in &mesh.faces {
+        for &v in f {
+            if let Some(u) = used.get_mut(v as usize) {
+                *u = true;
+            }
+        }
+    }
+    let mut seen: HashMap<[u64; 3], usize> = HashMap::new();
+    for (i, p) in mesh.points.iter().enumerate().filter(|(i, _)| used[*i]) {
+        let key = [p.x + 0.0, p.y + 0.0, p.z + 0.0].map(f64::to_bits);
+        if let Some(j) = seen.insert(key, i) {
+            return Err(format!(
+                "{what}: the result has coincident points (vertices {} and {} at {:?}); use a larger --neck/--cut or fewer steps",
+                j + 1,
+                i + 1,
+                p.to_array()
+            ));
+        }
+    }
+    for (k, f) in mesh.faces.iter().enumerate() {
+        let pts: Vec<glam::DVec3> = f.iter().map(|&v| mesh.points[v as usize]).collect();
+        let mut n = glam::DVec3::ZERO;
+        for i in 0..pts.len() {
+            n += pts[i].cross(pts[(i + 1) % pts.len()]);
+        }
+        if !(n.length() > 0.0) {
+            return Err(format!(
+                "{what}: face {} of the result has zero area; use a larger --neck/--cut or fewer steps",
+                k + 1
+            ));
+        }
+    }
+    Ok(())
+}

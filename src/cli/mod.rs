@@ -37,6 +37,9 @@ pub fn load(path: &std::path::Path) -> Result<tetrefine::TetMesh, String> {
     for n in notes {
         eprintln!("note: {}: {n}", path.display());
     }
+    if let Some(n) = guard::nonmanifold_note(&mesh) {
+        eprintln!("note: {}: {n}", path.display());
+    }
     if report.reoriented > 0 {
         eprintln!(
             "note: {}: {} tetrahedra were negatively oriented and have been turned around",

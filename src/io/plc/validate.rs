@@ -22,8 +22,67 @@ pub(super) struct Analysis {
     pub(super) tol: f64,
 }
 
+/// The power of two that brings the largest finite coordinate of `plc`
+/// near 1, when it is far from 1 (beyond 2^±400): lengths, areas and
+/// volumes of a surface at 1e±300 overflow or underflow in doubles, and the
+/// exact predicates assume neither. Scaling by a power of two is exact.
+fn scale_of(plc: &Plc) -> Option<f64> {
+    let m = plc
+        .points
+        .iter()
+        .flatten()
+        .map(|c| c.abs())
+        .filter(|c| c.is_finite() && *c > 0.0)
+        .fold(0.0f64, f64::max);
+    if m == 0.0 {
+        return None;
+    }
+    let e = m.log2().floor() as i32;
+    (e.abs() > 400).then(|| 2f64.powi(-e))
+}
+
+/// `plc` with every coordinate (points, holes, seeds) times `s` and the
+/// regions' volume bounds times `s³`.
+fn scaled(plc: &Plc, s: f64) -> Plc {
+    let sc = |p: &[f64; 3]| p.map(|c| c * s);
+    Plc {
+        points: plc.points.iter().map(sc).collect(),
+        facets: plc
+            .facets
+            .iter()
+            .map(|f| Facet {
+                polygons: f.polygons.clone(),
+                holes: f.holes.iter().map(sc).collect(),
+                marker: f.marker,
+            })
+            .collect(),
+        holes: plc.holes.iter().map(sc).collect(),
+        regions: plc
+            .regions
+            .iter()
+            .map(|r| super::Region {
+                point: sc(&r.point),
+                attribute: r.attribute,
+                max_volume: r.max_volume.map(|v| v * s * s * s),
+            })
+            .collect(),
+    }
+}
+
 impl Analysis {
     pub(super) fn run(plc: &Plc) -> Result<PlcVolume, PlcError> {
+        if let Some(s) = scale_of(plc) {
+            // Checked in exactly scaled coordinates; volumes scaled back (a
+            // volume beyond the doubles' range becomes infinite).
+            let mut v = Analysis::run_unscaled(&scaled(plc, s))?;
+            v.enclosed = v.enclosed / s / s / s;
+            v.planarity_slack = v.planarity_slack / s / s / s;
+            return Ok(v);
+        }
+        Analysis::run_unscaled(plc)
+    }
+
+    fn run_unscaled(plc: &Plc) -> Result<PlcVolume, PlcError> {
         let (pts, center, canon, diag, (lo, hi)) = check_points(plc)?;
         let tol = 1e-9 * diag;
         let mut a = Analysis {
