@@ -94,9 +94,9 @@ impl<'a> Lines<'a> {
         if !(0..=(u32::MAX / 4) as i64).contains(&n) {
             return Err(self.error(line, format!("{what} {n} is not valid")));
         }
-        // Every item takes at least one token: checked before anything is
-        // allocated for them.
-        let left = self.tokens_from[self.pos.min(self.lines.len())];
+        // Every item takes at least one token (of the count's own line or
+        // the lines after it): checked before anything is allocated.
+        let left = self.tokens_from[self.pos.saturating_sub(1).min(self.lines.len())];
         if n as usize > left {
             return Err(self.error(
                 line,

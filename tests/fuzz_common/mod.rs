@@ -187,6 +187,12 @@ pub fn seeds() -> Vec<Seed> {
     let mut s = vec![
         seed("medit", "m.mesh", read("meshes/mmg_cube.mesh"), Kind::Mesh),
         seed(
+            "medit (tetrefine)",
+            "m.mesh",
+            written(&mesh, "m.mesh"),
+            Kind::Mesh,
+        ),
+        seed(
             "gmsh 2.2 ascii",
             "m.msh",
             read("meshes/mmg_cube.msh"),
