@@ -65,8 +65,12 @@ pub struct Seed {
     pub siblings: Vec<(String, Vec<u8>)>,
 }
 
+/// The repository root (`$TETREFINE_ROOT` overrides it, for a soak run
+/// from a snapshot while the tree changes).
 fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).to_path_buf()
+    std::env::var_os("TETREFINE_ROOT")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).to_path_buf())
 }
 
 fn read(rel: &str) -> Vec<u8> {
