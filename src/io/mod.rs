@@ -6,8 +6,6 @@
 //! the file and, where there is one, the line. Writers go through
 //! [`write_atomic`], so a failed write never leaves a partial file behind.
 
-mod atomic;
-mod error;
 pub mod gid;
 pub mod gmsh;
 pub mod indicator;
@@ -20,14 +18,16 @@ pub mod tetgen;
 mod text;
 pub mod vtk;
 
-pub use atomic::{
-    install_signal_cleanup, remove_stale_temporaries, temporary_path, write_atomic, OutputSet,
-    TEMP_MARKER,
-};
-pub(crate) use error::open_message;
-pub use error::{IoError, IoErrorKind};
-pub(crate) use text::as_text;
 pub use text::Tokens;
+
+/// The file helpers (errors, whole-file reads, atomic writes and output
+/// sets) live below every area, in [`crate::file`], so that report and the
+/// surface schemes share them without going through `io`.
+pub use crate::file::{
+    install_signal_cleanup, remove_stale_temporaries, temporary_path, write_atomic, IoError,
+    IoErrorKind, OutputSet, TEMP_MARKER,
+};
+pub(crate) use crate::file::{open_message, read_bytes};
 
 use crate::mesh::{MeshData, TetMesh};
 use std::fs::File;
@@ -111,11 +111,6 @@ impl Format {
     }
 }
 
-/// Reads the whole file, with a clear error.
-pub(crate) fn read_bytes(path: &Path) -> Result<Vec<u8>, IoError> {
-    std::fs::read(path).map_err(|e| IoError::os(path, None, e))
-}
-
 /// Reads a mesh, choosing the format by extension.
 ///
 /// A file that is not a regular file (a named pipe, `/dev/stdin`) is read
@@ -191,7 +186,8 @@ pub fn load_mesh_noted(
     path: &Path,
 ) -> Result<(TetMesh, crate::mesh::BuildReport, Vec<String>), IoError> {
     let (data, notes) = read_mesh_noted(path)?;
-    let (mesh, report) = TetMesh::from_data(&data).map_err(|e| IoError::mesh(path, e))?;
+    let (mesh, report) = TetMesh::from_data(&data)
+        .map_err(|e| IoError::content(path, e.line().map(|l| l as usize), e))?;
     Ok((mesh, report, notes))
 }
 
