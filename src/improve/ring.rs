@@ -15,7 +15,7 @@
 //! already beat the bar. Most rings tried by the optimize phase cannot be
 //! improved, so this is where the phase used to spend a third of its time.
 
-use crate::geom::{orient3d, tet_min_sine};
+use crate::geom::{is_positive, tet_min_sine};
 use crate::mesh::TetMesh;
 use crate::ops::edge_removal::{EdgeRing, RingTriangulation};
 use glam::DVec3;
@@ -65,9 +65,7 @@ pub fn improving_ring_triangulation(
         if q.is_nan() || q <= beat {
             return f64::NEG_INFINITY;
         }
-        if orient3d(ta[0], ta[1], ta[2], ta[3]) <= 0.0
-            || orient3d(tb[0], tb[1], tb[2], tb[3]) <= 0.0
-        {
+        if !is_positive(&ta) || !is_positive(&tb) {
             return f64::NEG_INFINITY;
         }
         q

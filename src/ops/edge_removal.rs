@@ -20,7 +20,7 @@
 //! paper §4: the new boundary edge joins the two face barycentres p0 and p_m.
 
 use super::{replace_cavity, OpError};
-use crate::geom::{orient3d, tet_min_sine};
+use crate::geom::{is_positive, tet_min_sine};
 use crate::mesh::{TetMesh, NO_ADJ};
 use crate::topo::{TET_EDGES, TET_EDGE_OPPOSITE};
 
@@ -170,9 +170,7 @@ pub fn best_ring_triangulation(mesh: &TetMesh, ring: &EdgeRing) -> RingTriangula
     let tri_q = |i: usize, k: usize, j: usize| -> f64 {
         let ta = [pa, p[i], p[k], p[j]];
         let tb = [pb, p[j], p[k], p[i]];
-        if orient3d(ta[0], ta[1], ta[2], ta[3]) <= 0.0
-            || orient3d(tb[0], tb[1], tb[2], tb[3]) <= 0.0
-        {
+        if !is_positive(&ta) || !is_positive(&tb) {
             return f64::NEG_INFINITY;
         }
         tet_min_sine(&ta).min(tet_min_sine(&tb))

@@ -754,3 +754,42 @@ f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\n",
         assert!(o.status.success(), "{scheme}: {}", stderr(&o));
     }
 }
+
+/// Tets whose Jacobian determinant in doubles is not positive.
+fn solver_inverted(path: &Path) -> usize {
+    let (m, _) = tetrefine::io::load_mesh(path).unwrap();
+    m.tet_ids()
+        .filter(|&t| {
+            let p = m.tet_points(t);
+            !((p[1] - p[0]).dot((p[2] - p[0]).cross(p[3] - p[0])) > 0.0)
+        })
+        .count()
+}
+
+#[test]
+fn refined_tets_are_positive_in_doubles_too() {
+    // The issue's case: two steps without optimization, and stopping after
+    // each topological phase.
+    let dir = tempfile::tempdir().unwrap();
+    for (mesh, extra) in [
+        ("gmsh_t16.msh", &["--steps", "2", "--opt-passes", "0"][..]),
+        (
+            "gmsh_t16.msh",
+            &["--steps", "2", "--stop-after", "flip"][..],
+        ),
+        (
+            "gmsh_t16.msh",
+            &["--steps", "2", "--stop-after", "boundary-flip"][..],
+        ),
+        ("mmg_cube.mesh", &["--steps", "2", "--opt-passes", "0"][..]),
+    ] {
+        let out = dir.path().join("o.mesh");
+        let mut args = vec!["refine", "-o", out.to_str().unwrap()];
+        let input = meshes().join(mesh);
+        args.insert(1, input.to_str().unwrap());
+        args.extend_from_slice(extra);
+        let o = tetrefine(&args);
+        assert!(o.status.success(), "{mesh} {extra:?}: {}", stderr(&o));
+        assert_eq!(solver_inverted(&out), 0, "{mesh} {extra:?}");
+    }
+}
