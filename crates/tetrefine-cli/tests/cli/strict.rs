@@ -793,3 +793,43 @@ fn refined_tets_are_positive_in_doubles_too() {
         assert_eq!(solver_inverted(&out), 0, "{mesh} {extra:?}");
     }
 }
+
+#[test]
+fn the_linear_rule_keeps_a_flat_tet_exactly() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("flat.mesh");
+    std::fs::write(
+        &input,
+        "MeshVersionFormatted 2\nDimension 3\nVertices\n4\n0 0 0 0\n1 0 0 0\n0 1 0 0\n0.3 0.3 0.1 0\nTetrahedra\n1\n1 2 3 4 1\nEnd\n",
+    )
+    .unwrap();
+    // Base area 1/2, height 0.1.
+    let want = 0.5 * 0.1 / 3.0;
+    for steps in ["1", "2"] {
+        let out = dir.path().join("o.mesh");
+        let o = tetrefine(&[
+            "refine",
+            input.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+            "--boundary",
+            "linear",
+            "--steps",
+            steps,
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        let (m, _) = tetrefine::io::load_mesh(&out).unwrap();
+        assert!(m.n_tets() > 1, "refined");
+        let v: f64 = m
+            .tet_ids()
+            .map(|t| {
+                let p = m.tet_points(t);
+                (p[1] - p[0]).dot((p[2] - p[0]).cross(p[3] - p[0])) / 6.0
+            })
+            .sum();
+        assert!(
+            (v - want).abs() <= 1e-12 * want,
+            "{steps} steps: {v} vs {want}"
+        );
+    }
+}
