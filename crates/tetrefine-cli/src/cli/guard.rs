@@ -171,7 +171,7 @@ pub fn check_selection(strategy: &MarkStrategy, mesh: &TetMesh) -> Result<(), St
         }
         MarkStrategy::Box { min, max } => {
             for (axis, name) in ["x", "y", "z"].iter().enumerate() {
-                if !(max[axis] > min[axis]) {
+                if max[axis].partial_cmp(&min[axis]) != Some(std::cmp::Ordering::Greater) {
                     return Err(format!(
                         "--mark {strategy}: the box has zero extent along {name}, so it holds no tet's centroid but by accident"
                     ));
@@ -311,7 +311,7 @@ pub fn check_surface_output(mesh: &tetrefine_surface::PolyMesh, what: &str) -> R
         for i in 0..pts.len() {
             n += pts[i].cross(pts[(i + 1) % pts.len()]);
         }
-        if !(n.length() > 0.0) {
+        if n.length().partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
             return Err(format!(
                 "{what}: face {} of the result has zero area; use a larger --neck/--cut or fewer steps",
                 k + 1

@@ -761,7 +761,8 @@ fn solver_inverted(path: &Path) -> usize {
     m.tet_ids()
         .filter(|&t| {
             let p = m.tet_points(t);
-            !((p[1] - p[0]).dot((p[2] - p[0]).cross(p[3] - p[0])) > 0.0)
+            let det = (p[1] - p[0]).dot((p[2] - p[0]).cross(p[3] - p[0]));
+            det.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater)
         })
         .count()
 }
