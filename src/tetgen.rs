@@ -341,6 +341,7 @@ fn quiet_stdout<R>(f: impl FnOnce() -> R) -> R {
     // restored and closed before returning. TetGen calls are serialised.
     let saved = unsafe { libc::dup(1) };
     if saved >= 0 {
+        // SAFETY: points descriptor 1 at the open descriptor 2; undone below.
         unsafe { libc::dup2(2, 1) };
     }
     let r = f();
