@@ -834,3 +834,28 @@ fn the_linear_rule_keeps_a_flat_tet_exactly() {
         );
     }
 }
+
+#[test]
+fn fuzz_findings_in_tests_bad_surface_give_one_line_naming_the_file() {
+    // A cube whose vertex order a mutation twisted: a valid oriented
+    // manifold whose Catmull–Clark face points coincide (the fuzzer found
+    // the error line did not name the file).
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("o.obj");
+    let bad = crate::support::root().join("tests/bad/surface/twisted_cube.off");
+    let o = tetrefine(&[
+        "surface",
+        "catmull-clark",
+        bad.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    let e = stderr(&o);
+    assert_eq!(e.lines().count(), 1, "{e}");
+    assert!(
+        e.contains("twisted_cube.off") && e.contains("coincident"),
+        "{e}"
+    );
+    assert!(!out.exists());
+}
