@@ -573,12 +573,18 @@ fn outside_seeds_and_hostile_switches_are_refused_cleanly() {
     ] {
         s += &format!("1\n4 {} {} {} {}\n", q[0], q[1], q[2], q[3]);
     }
+    std::fs::write(dir.path().join("plain.poly"), format!("{s}0\n0\n")).unwrap();
     s += "0\n1\n1 0.5 0.5 2 7\n";
     std::fs::write(&poly, s).unwrap();
     let out = dir.path().join("o.mesh");
     let run = |extra: &[&str]| {
+        let input = if extra.is_empty() {
+            poly.clone()
+        } else {
+            dir.path().join("plain.poly")
+        };
         let mut c = Command::new(env!("CARGO_BIN_EXE_tetrefine"));
-        c.args(["mesh", poly.to_str().unwrap(), "-o", out.to_str().unwrap()]);
+        c.args(["mesh", input.to_str().unwrap(), "-o", out.to_str().unwrap()]);
         c.args(extra);
         c.output().unwrap()
     };
@@ -592,9 +598,18 @@ fn outside_seeds_and_hostile_switches_are_refused_cleanly() {
     assert!(String::from_utf8_lossy(&o.stderr).contains("outside the surface"));
     assert!(o.stdout.is_empty() && !out.exists());
     let long = "p".repeat(1024);
+    assert!(
+        run(&["--switches", "pq1.414"]).status.success(),
+        "the plain cube meshes"
+    );
+    std::fs::remove_file(&out).unwrap();
     for sw in [long.as_str(), "q0.5", "q1.2/75", "a-1"] {
         let o = run(&["--switches", sw]);
         assert_eq!(o.status.code(), Some(1), "{sw}");
+        assert!(
+            String::from_utf8_lossy(&o.stderr).contains("switch"),
+            "{sw}"
+        );
         assert!(!out.exists());
     }
 }
