@@ -113,7 +113,11 @@ impl IoError {
                 Some(d) => format!("{d}: {}", open_message(source)),
                 None => open_message(source),
             },
-            IoErrorKind::Invalid(m) => m.clone(),
+            // One line, even when the message quotes a garbled file.
+            IoErrorKind::Invalid(m) => m
+                .chars()
+                .map(|c| if c.is_control() { ' ' } else { c })
+                .collect(),
             IoErrorKind::Content(e) => e.to_string(),
             IoErrorKind::Decode { what, source } => format!("{what}: {source}"),
         }
