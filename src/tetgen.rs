@@ -96,9 +96,86 @@ const REFUSED: [(char, &str); 10] = [
     ('E', "-E suppresses the output tetrahedra"),
 ];
 
+/// Longest user switch string accepted (TetGen's own buffer holds 1,024).
+pub const MAX_SWITCHES_LEN: usize = 256;
+
+/// The switches of `s` that take a number, with their number text
+/// (`q1.414/18` → `('q', "1.414/18")`), in order.
+fn switch_values(s: &str) -> Vec<(char, &str)> {
+    let b = s.as_bytes();
+    let mut out = Vec::new();
+    let mut i = 0;
+    while i < b.len() {
+        let c = b[i] as char;
+        i += 1;
+        if matches!(c, 'q' | 'a' | 'O' | 'T' | 'S') {
+            let start = i;
+            while i < b.len() && (b[i].is_ascii_digit() || b"./eE+-".contains(&b[i])) {
+                // An 'e' is an exponent only right after a digit or '.'.
+                if (b[i] == b'e' || b[i] == b'E')
+                    && !(i > start && (b[i - 1].is_ascii_digit() || b[i - 1] == b'.'))
+                {
+                    break;
+                }
+                i += 1;
+            }
+            out.push((c, &s[start..i]));
+        }
+    }
+    out
+}
+
+/// The last maximum volume of a switch string (`a<V>`), if any.
+pub fn max_volume_switch(s: &str) -> Option<f64> {
+    switch_values(s)
+        .into_iter()
+        .filter(|(c, v)| *c == 'a' && !v.is_empty())
+        .filter_map(|(_, v)| v.parse::<f64>().ok())
+        .next_back()
+}
+
 /// Checks the user's switches: printable ASCII, no refused switch,
 /// no second-order elements.
 fn check_switches(s: &str, refine: bool) -> Result<(), TetgenError> {
+    // TetGen copies the switches into a 1 KiB buffer (and aborts beyond it).
+    if s.len() > MAX_SWITCHES_LEN {
+        return Err(TetgenError::Options(format!(
+            "TetGen switches of {} characters: at most {MAX_SWITCHES_LEN} are accepted",
+            s.len()
+        )));
+    }
+    for (letter, value) in switch_values(s) {
+        let bad = |why: &str| {
+            Err(TetgenError::Options(format!(
+                "TetGen switch -{letter}{value}: {why}"
+            )))
+        };
+        let mut parts = value.split('/');
+        let first = parts.next().unwrap_or("");
+        let num = |t: &str| t.parse::<f64>().ok().filter(|x| x.is_finite());
+        match letter {
+            'q' => {
+                if let Some(r) = (!first.is_empty()).then(|| num(first)).flatten() {
+                    if r < 1.0 {
+                        return bad("a radius-edge bound below 1.0, where TetGen's refinement need not terminate");
+                    }
+                } else if !first.is_empty() {
+                    return bad("the radius-edge bound is not a number");
+                }
+                if let Some(d) = parts.next() {
+                    match num(d) {
+                        Some(d) if d > 0.0 && d < 70.0 => {}
+                        _ => return bad("the minimum dihedral angle must lie in (0, 70) degrees"),
+                    }
+                }
+            }
+            'a' if !first.is_empty() => match num(first) {
+                Some(v) if v > 0.0 => {}
+                _ => return bad("the maximum volume must be a positive number"),
+            },
+            _ => {}
+        }
+    }
     if let Some(c) = s.chars().find(|c| !c.is_ascii_graphic()) {
         return Err(TetgenError::Options(format!(
             "TetGen switches must be printable ASCII without spaces, found {c:?}"
@@ -254,6 +331,60 @@ fn region_volumes(mesh: &TetMesh) -> BTreeMap<i32, f64> {
     v
 }
 
+/// Runs `f` with the process's standard output sent to standard error, so
+/// that what TetGen prints (it writes messages with `printf` even with `-Q`
+/// on some errors) never mixes with the command's own output.
+fn quiet_stdout<R>(f: impl FnOnce() -> R) -> R {
+    use std::io::Write;
+    let _ = std::io::stdout().flush();
+    // SAFETY: dup/dup2/close on the standard descriptors; the saved copy is
+    // restored and closed before returning. TetGen calls are serialised.
+    let saved = unsafe { libc::dup(1) };
+    if saved >= 0 {
+        // SAFETY: points descriptor 1 at the open descriptor 2; undone below.
+        unsafe { libc::dup2(2, 1) };
+    }
+    let r = f();
+    if saved >= 0 {
+        // SAFETY: as above; C's stdout buffer is flushed first.
+        unsafe {
+            libc::fflush(std::ptr::null_mut());
+            libc::dup2(saved, 1);
+            libc::close(saved);
+        }
+    }
+    r
+}
+
+/// TetGen's bytes per output tet, generously (its mesh, pools and the
+/// output arrays).
+const TETGEN_BYTES_PER_TET: f64 = 400.0;
+
+/// Refuses a maximum volume bound whose mesh would not fit in memory:
+/// TetGen makes at least `enclosed / V` tets (about six times as many in
+/// practice), each taking [`TETGEN_BYTES_PER_TET`].
+fn check_size(enclosed: f64, sw: &str) -> Result<(), TetgenError> {
+    let Some(v) = max_volume_switch(sw) else {
+        return Ok(());
+    };
+    let tets = 6.0 * enclosed / v;
+    let need = tets * TETGEN_BYTES_PER_TET;
+    let available = std::fs::read_to_string("/proc/meminfo").ok().and_then(|t| {
+        t.lines()
+            .find(|l| l.starts_with("MemAvailable:"))
+            .and_then(|l| l.split_whitespace().nth(1)?.parse::<f64>().ok())
+            .map(|kb| kb * 1024.0)
+    });
+    match available {
+        Some(a) if need > a => Err(TetgenError::Options(format!(
+            "a maximum tet volume of {v:e} for an enclosed volume of {enclosed:e} means about {tets:.2e} tets and {:.1} GiB, more than the {:.1} GiB available",
+            need / (1u64 << 30) as f64,
+            a / (1u64 << 30) as f64
+        ))),
+        _ => Ok(()),
+    }
+}
+
 fn check_volume(expected: f64, got: f64, slack: f64, switches: &str) -> Result<(), TetgenError> {
     if (got - expected).abs() <= 1e-9 * expected.abs() + 2.0 * slack {
         Ok(())
@@ -284,6 +415,7 @@ pub fn tetrahedralize(plc: &Plc, opts: &Options) -> Result<TetMesh, TetgenError>
     }
     let analysis = plc.analyze()?;
     let sw = switches(opts, false, if plc.regions.is_empty() { "" } else { "A" })?;
+    check_size(analysis.enclosed, &sw)?;
 
     // Merge coincident points: TetGen would warn and drop them itself.
     let canon = plc.coincident_point_map();
@@ -339,7 +471,7 @@ pub fn tetrahedralize(plc: &Plc, opts: &Options) -> Result<TetMesh, TetgenError>
         regions: &regions,
         ..Default::default()
     };
-    let out = tetgen_ffi::tetrahedralize(&sw, &input).map_err(ffi_error)?;
+    let out = quiet_stdout(|| tetgen_ffi::tetrahedralize(&sw, &input)).map_err(ffi_error)?;
     let mesh = build_mesh(out, &sw)?;
     check_volume(
         analysis.enclosed,
@@ -433,7 +565,7 @@ pub fn refine(mesh: &TetMesh, opts: &Options) -> Result<TetMesh, TetgenError> {
         trifacemarkers: &trifacemarkers,
         ..Default::default()
     };
-    let out = tetgen_ffi::tetrahedralize(&sw, &input).map_err(ffi_error)?;
+    let out = quiet_stdout(|| tetgen_ffi::tetrahedralize(&sw, &input)).map_err(ffi_error)?;
     let refined = build_mesh(out, &sw)?;
     let before = region_volumes(&m);
     let after = region_volumes(&refined);

@@ -3,5 +3,7 @@
 pub mod predicates;
 pub mod quality;
 
-pub use predicates::{all_positive, is_positive, orient3d, orient3d_sign, Orientation};
+pub use predicates::{
+    all_positive, is_positive, orient3d, orient3d_sign, positive_in_doubles, Orientation,
+};
 pub use quality::{dihedral_angles, tet_min_sine, tet_quality, tet_volume, TetQuality};

@@ -55,11 +55,21 @@ pub fn orient3d_sign(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> Orientation {
     }
 }
 
-/// Whether the tet with corners `p` is positively oriented (exact predicate):
-/// neither inverted nor flat. Every operation checks its new tets with this.
+/// Whether the tet with corners `p` is positively oriented: exactly (the
+/// exact predicate), and also as a solver computing in doubles sees it (the
+/// Jacobian determinant `(p1 − p0) · ((p2 − p0) × (p3 − p0))` evaluated in
+/// `f64`, as FEM codes and [`crate::geom::tet_volume`] do). A sliver can be
+/// positive exactly yet negative in doubles; every operation checks its new
+/// tets with this, so it refuses such tets as it refuses inverted ones.
 #[inline]
 pub fn is_positive(p: &[DVec3; 4]) -> bool {
-    orient3d(p[0], p[1], p[2], p[3]) > 0.0
+    orient3d(p[0], p[1], p[2], p[3]) > 0.0 && positive_in_doubles(p)
+}
+
+/// The Jacobian determinant of the tet in plain `f64` arithmetic is > 0.
+#[inline]
+pub fn positive_in_doubles(p: &[DVec3; 4]) -> bool {
+    (p[1] - p[0]).dot((p[2] - p[0]).cross(p[3] - p[0])) > 0.0
 }
 
 /// Whether every tet (as its four corners) is positively oriented: the one
@@ -72,6 +82,34 @@ pub fn all_positive(tets: impl IntoIterator<Item = [DVec3; 4]>) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_sliver_positive_exactly_but_not_in_doubles_is_not_positive() {
+        // Nearly coplanar tets: d on the plane of abc up to rounding. The
+        // exact and the double-precision signs then disagree often.
+        let mut state = 0x1234_5678_9ABC_DEF0u64;
+        let mut next = || {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let mut disagreements = 0;
+        for _ in 0..10_000 {
+            let mut r = || DVec3::new(next(), next(), next());
+            let (a, b, c) = (r(), r(), r());
+            let (s, t) = (next(), next());
+            let d = a + s * (b - a) + t * (c - a);
+            let p = [a, b, c, d];
+            let exact = orient3d(a, b, c, d) > 0.0;
+            let doubles = (b - a).dot((c - a).cross(d - a)) > 0.0;
+            assert_eq!(is_positive(&p), exact && doubles);
+            if exact && !doubles {
+                disagreements += 1;
+            }
+        }
+        assert!(disagreements > 100, "{disagreements}");
+    }
 
     #[test]
     fn corner_tet_is_positive_and_swapped_is_negative() {

@@ -21,11 +21,14 @@ pub mod vtk;
 
 pub use text::Tokens;
 
+/// The file helpers (errors, whole-file reads, atomic writes and output
+/// sets) live below every area, in [`crate::file`], so that report and the
+/// surface schemes share them without going through `io`.
+pub use crate::file::{
+    install_signal_cleanup, remove_stale_temporaries, temporary_path, write_atomic, IoError,
+    IoErrorKind, OutputSet, TEMP_MARKER,
+};
 pub(crate) use crate::file::{open_message, read_bytes};
-/// The file helpers (errors, whole-file reads, atomic writes) live below
-/// every area, in [`crate::file`], so that report and the surface schemes
-/// share them without going through `io`.
-pub use crate::file::{write_atomic, IoError};
 
 use crate::mesh::{MeshData, TetMesh};
 use std::fs::File;
@@ -64,10 +67,10 @@ impl Format {
                 let mut head = Vec::with_capacity(4096);
                 {
                     use std::io::Read;
-                    let f = File::open(path).map_err(|e| IoError::file(path, open_message(&e)))?;
+                    let f = File::open(path).map_err(|e| IoError::os(path, None, e))?;
                     f.take(4096)
                         .read_to_end(&mut head)
-                        .map_err(|e| IoError::file(path, e.to_string()))?;
+                        .map_err(|e| IoError::os(path, None, e))?;
                 }
                 // The first word outside GiD's `#` comment lines.
                 let text = String::from_utf8_lossy(&head);
@@ -110,24 +113,83 @@ impl Format {
 }
 
 /// Reads a mesh, choosing the format by extension.
+///
+/// A file that is not a regular file (a named pipe, `/dev/stdin`) is read
+/// once into a private temporary copy, which the reader then reads (and
+/// sniffs, for `.msh`); errors still name `path`.
 pub fn read_mesh(path: &Path) -> Result<MeshData, IoError> {
+    read_mesh_noted(path).map(|(d, _)| d)
+}
+
+/// [`read_mesh`], and the reader's notes on what it dropped (cells of a
+/// mixed-cell `.vtu` other than tetrahedra and triangles, say), one
+/// sentence each.
+pub fn read_mesh_noted(path: &Path) -> Result<(MeshData, Vec<String>), IoError> {
+    let meta = std::fs::metadata(path).map_err(|e| IoError::os(path, None, e))?;
+    if meta.is_dir() {
+        return Err(IoError::file(path, "is a directory, not a mesh file"));
+    }
+    if !meta.is_file() {
+        return spooled(path, read_mesh_file);
+    }
+    read_mesh_file(path)
+}
+
+/// Copies the stream `path` once into a temporary regular file with the
+/// same extension, runs `read` on it and names `path` in its errors.
+pub(crate) fn spooled<T>(
+    path: &Path,
+    read: impl FnOnce(&Path) -> Result<T, IoError>,
+) -> Result<T, IoError> {
+    let bytes = read_bytes(path)?;
+    let ext = path
+        .extension()
+        .map(|e| e.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let dir = std::env::temp_dir();
+    let copy = dir.join(format!(
+        "tetrefine-input{TEMP_MARKER}{}-{}.{ext}",
+        std::process::id(),
+        SPOOL.fetch_add(1, std::sync::atomic::Ordering::Relaxed)
+    ));
+    std::fs::write(&copy, &bytes)
+        .map_err(|e| IoError::os(&copy, Some("cannot copy a piped input"), e))?;
+    let r = read(&copy);
+    let _ = std::fs::remove_file(&copy);
+    r.map_err(|mut e| {
+        if e.path == copy {
+            e.path = path.to_path_buf();
+        }
+        e
+    })
+}
+
+static SPOOL: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+
+fn read_mesh_file(path: &Path) -> Result<(MeshData, Vec<String>), IoError> {
+    let plain = |d: MeshData| (d, Vec::new());
     match Format::for_reading(path)? {
-        Format::Medit => medit::read(path),
-        Format::Gmsh => gmsh::read(path),
-        Format::Gid => gid::read(path),
-        Format::Vtu => vtk::read(path),
-        Format::Tetgen => tetgen::read(path),
+        Format::Medit => medit::read(path).map(plain),
+        Format::Gmsh => gmsh::read(path).map(plain),
+        Format::Gid => gid::read(path).map(plain),
+        Format::Vtu => vtk::read_noted(path).map(|(d, n)| (d, n.into_iter().collect())),
+        Format::Tetgen => tetgen::read(path).map(plain),
     }
 }
 
 /// Reads a mesh and builds the store; build errors name the file and line.
 pub fn load_mesh(path: &Path) -> Result<(TetMesh, crate::mesh::BuildReport), IoError> {
-    let data = read_mesh(path)?;
-    TetMesh::from_data(&data).map_err(|e| IoError {
-        path: path.to_path_buf(),
-        line: e.line().map(|l| l as usize),
-        message: e.to_string(),
-    })
+    load_mesh_noted(path).map(|(m, r, _)| (m, r))
+}
+
+/// [`load_mesh`], and the reader's notes (see [`read_mesh_noted`]).
+pub fn load_mesh_noted(
+    path: &Path,
+) -> Result<(TetMesh, crate::mesh::BuildReport, Vec<String>), IoError> {
+    let (data, notes) = read_mesh_noted(path)?;
+    let (mesh, report) = TetMesh::from_data(&data)
+        .map_err(|e| IoError::content(path, e.line().map(|l| l as usize), e))?;
+    Ok((mesh, report, notes))
 }
 
 /// Writes `mesh` in the format given by the extension of `path`.
@@ -135,7 +197,7 @@ pub fn write_mesh(path: &Path, mesh: &TetMesh) -> Result<(), IoError> {
     match Format::for_writing(path)? {
         Format::Medit => medit::write(path, mesh),
         Format::Gmsh => gmsh::write(path, mesh),
-        Format::Vtu => vtk::write_vtu(path, mesh, &[]),
+        Format::Vtu => vtk::write_vtu(path, mesh, None, &[]),
         Format::Tetgen => tetgen::write(path, mesh),
         Format::Gid => Err(IoError::file(path, "writing GiD is not supported")),
     }

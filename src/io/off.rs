@@ -57,6 +57,17 @@ pub fn read(path: &Path) -> Result<Plc, IoError> {
     };
     let nv = count(counts.first(), "the vertex count")?;
     let nf = count(counts.get(1), "the face count")?;
+    // A vertex line takes at least 6 bytes ("0 0 0\n") and a face line 8:
+    // a count the file cannot hold is refused before anything is allocated.
+    if nv.saturating_mul(6).saturating_add(nf.saturating_mul(8)) > text.len() {
+        return Err(err(
+            l,
+            format!(
+                "{nv} vertices and {nf} faces cannot fit in the {} bytes of the file (truncated or corrupt counts)",
+                text.len()
+            ),
+        ));
+    }
     let mut points = Vec::with_capacity(nv);
     let mut last = l;
     for _ in 0..nv {

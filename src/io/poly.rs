@@ -30,6 +30,9 @@ struct Lines<'a> {
     pos: usize,
     /// Line of the last line returned (for errors after the end).
     last: usize,
+    /// `tokens_from[i]`: the number of tokens on lines `i..` (a count may not
+    /// promise more items than there are tokens left).
+    tokens_from: Vec<usize>,
 }
 
 impl<'a> Lines<'a> {
@@ -42,12 +45,17 @@ impl<'a> Lines<'a> {
                 let toks: Vec<&str> = l.split_whitespace().collect();
                 (!toks.is_empty()).then_some((i + 1, toks))
             })
-            .collect();
+            .collect::<Vec<(usize, Vec<&str>)>>();
+        let mut tokens_from = vec![0; lines.len() + 1];
+        for i in (0..lines.len()).rev() {
+            tokens_from[i] = tokens_from[i + 1] + lines[i].1.len();
+        }
         Lines {
             path,
             lines,
             pos: 0,
             last: 1,
+            tokens_from,
         }
     }
 
@@ -85,6 +93,15 @@ impl<'a> Lines<'a> {
         let n: i64 = self.parse(line, tok, what)?;
         if !(0..=(u32::MAX / 4) as i64).contains(&n) {
             return Err(self.error(line, format!("{what} {n} is not valid")));
+        }
+        // Every item takes at least one token (of the count's own line or
+        // the lines after it): checked before anything is allocated.
+        let left = self.tokens_from[self.pos.saturating_sub(1).min(self.lines.len())];
+        if n as usize > left {
+            return Err(self.error(
+                line,
+                format!("{what} {n} is more than the {left} values left in the file (truncated or corrupt count)"),
+            ));
         }
         Ok(n as usize)
     }

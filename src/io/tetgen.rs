@@ -45,7 +45,93 @@ pub fn read(path: &Path) -> Result<MeshData, IoError> {
     if quadratic {
         drop_unused_points(&mut data);
     }
+    check_set(&data, &node_path, &face_path, &edge_path)?;
     Ok(data)
+}
+
+/// Refuses a set whose files do not belong together (a partly replaced
+/// output, say): points of `.node` that no tet of `.ele` uses (TetGen
+/// jettisons unused points, and tetrefine writes none), triangles of `.face`
+/// that are not faces of a tet, edges of `.edge` that are not tet edges.
+fn check_set(data: &MeshData, node: &Path, face: &Path, edge: &Path) -> Result<(), IoError> {
+    use std::collections::HashSet;
+    let mut used = vec![false; data.points.len()];
+    for t in &data.tets {
+        for &v in t {
+            used[v as usize] = true;
+        }
+    }
+    let unused = used.iter().filter(|&&u| !u).count();
+    if unused > 0 {
+        let first = used.iter().position(|&u| !u).unwrap_or(0);
+        return Err(IoError::file(
+            node,
+            format!(
+                "{unused} of its {} points (the first is point {} in file order) belong to no tetrahedron of {}: the files of this TetGen set do not belong together",
+                data.points.len(),
+                first + 1,
+                node.with_extension("ele").display()
+            ),
+        ));
+    }
+    let sorted3 = |mut f: [u32; 3]| {
+        f.sort_unstable();
+        f
+    };
+    if !data.triangles.is_empty() {
+        let faces: HashSet<[u32; 3]> = data
+            .tets
+            .iter()
+            .flat_map(|t| {
+                [
+                    [t[1], t[2], t[3]],
+                    [t[0], t[2], t[3]],
+                    [t[0], t[1], t[3]],
+                    [t[0], t[1], t[2]],
+                ]
+            })
+            .map(sorted3)
+            .collect();
+        if let Some(i) = data
+            .triangles
+            .iter()
+            .position(|(f, _)| !faces.contains(&sorted3(*f)))
+        {
+            return Err(IoError::file(
+                face,
+                format!(
+                    "face {} (in file order) is not a face of any tetrahedron of {}: the files of this TetGen set do not belong together",
+                    i + 1,
+                    node.with_extension("ele").display()
+                ),
+            ));
+        }
+    }
+    if !data.edges.is_empty() {
+        let key = |a: u32, b: u32| [a.min(b), a.max(b)];
+        let edges: HashSet<[u32; 2]> = data
+            .tets
+            .iter()
+            .flat_map(|t| {
+                [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)].map(|(i, j)| key(t[i], t[j]))
+            })
+            .collect();
+        if let Some(i) = data
+            .edges
+            .iter()
+            .position(|(e, _)| !edges.contains(&key(e[0], e[1])))
+        {
+            return Err(IoError::file(
+                edge,
+                format!(
+                    "edge {} (in file order) is not an edge of any tetrahedron of {}: the files of this TetGen set do not belong together",
+                    i + 1,
+                    node.with_extension("ele").display()
+                ),
+            ));
+        }
+    }
+    Ok(())
 }
 
 fn load(path: &Path) -> Result<Vec<u8>, IoError> {
@@ -252,11 +338,29 @@ pub fn write(path: &Path, mesh: &TetMesh) -> Result<(), IoError> {
     write_data(path, &mesh.to_data())
 }
 
-/// Writes plain mesh data as TetGen files; if one of them cannot be written,
-/// those already written are removed again.
+/// Writes plain mesh data as TetGen files, as one set: the four files are
+/// renamed into place only when all four were written (inside an open
+/// [`super::OutputSet`], with the rest of its outputs), so a failure leaves
+/// the old set whole. Points no tet uses are left out (a reader refuses a
+/// set with unused points).
 pub fn write_data(path: &Path, d: &MeshData) -> Result<(), IoError> {
+    let mut owned;
+    let d = if d
+        .tets
+        .iter()
+        .flatten()
+        .collect::<std::collections::HashSet<_>>()
+        .len()
+        < d.points.len()
+    {
+        owned = d.clone();
+        drop_unused_points(&mut owned);
+        &owned
+    } else {
+        d
+    };
     let files = ["node", "ele", "face", "edge"].map(|e| sibling(path, e));
-    let mut written = 0;
+    let set = super::OutputSet::begin();
     let result = (|| {
         write_atomic(&files[0], |w| {
             writeln!(w, "# written by tetrefine\n{} 3 0 0", d.points.len())?;
@@ -265,7 +369,6 @@ pub fn write_data(path: &Path, d: &MeshData) -> Result<(), IoError> {
             }
             Ok(())
         })?;
-        written = 1;
         write_atomic(&files[1], |w| {
             writeln!(
                 w,
@@ -286,7 +389,6 @@ pub fn write_data(path: &Path, d: &MeshData) -> Result<(), IoError> {
             }
             Ok(())
         })?;
-        written = 2;
         write_atomic(&files[2], |w| {
             writeln!(
                 w,
@@ -298,7 +400,6 @@ pub fn write_data(path: &Path, d: &MeshData) -> Result<(), IoError> {
             }
             Ok(())
         })?;
-        written = 3;
         write_atomic(&files[3], |w| {
             writeln!(
                 w,
@@ -311,10 +412,8 @@ pub fn write_data(path: &Path, d: &MeshData) -> Result<(), IoError> {
             Ok(())
         })
     })();
-    if result.is_err() {
-        for f in &files[..written] {
-            let _ = std::fs::remove_file(f);
-        }
+    match result {
+        Ok(()) => set.commit(),
+        Err(e) => Err(e), // dropping the set removes what was staged
     }
-    result
 }

@@ -185,7 +185,8 @@ pub struct StepReport {
     /// Old boundary edges flipped.
     pub boundary_flipped: usize,
     /// Boundary edge flips refused (would invert, marker change, untagged
-    /// junction, or not all faces around the edge split).
+    /// junction, not all faces around the edge split, or, with the linear
+    /// rule, faces not exactly coplanar).
     pub refused_boundary_flips: usize,
     /// Interface faces split 2-6.
     pub interface_split: usize,

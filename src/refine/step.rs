@@ -106,7 +106,12 @@ pub fn refine_step_with_progress(
             Phase::Split => split_phase(mesh, opts, &mut report),
             Phase::Flip => flip_phase(mesh, &st, &mut report),
             Phase::BoundarySplit => boundary_split_phase(mesh, &mut st, &mut report),
-            Phase::BoundaryFlip => boundary_flip_phase(mesh, &mut st, &mut report),
+            Phase::BoundaryFlip => boundary_flip_phase(
+                mesh,
+                &mut st,
+                opts.boundary == crate::stencil::Sqrt3Rule::Linear,
+                &mut report,
+            ),
             Phase::BoundarySmooth => boundary_smooth_phase(mesh, &st, opts, &mut report),
             Phase::Optimize => {
                 // The topological phases appended tets and points at the ends
@@ -288,8 +293,31 @@ fn flat_enough(mesh: &TetMesh, a: u32, b: u32, m1: u32, m2: u32) -> bool {
 /// two-sided removal of [`remove_interface_edge`]), so that the new edge joins
 /// two face points. Feature edges are kept in odd steps and trisected in even
 /// steps (the √3 paper, §5).
-fn boundary_flip_phase(mesh: &mut TetMesh, st: &mut StepState, report: &mut StepReport) {
+///
+/// With the linear rule (`linear`), which promises to keep the domain
+/// exactly, a boundary edge is flipped only where its two old faces are
+/// exactly coplanar (exact `orient3d` of the edge and their opposite
+/// corners is zero): across any bend, however slight, the new edge between
+/// the face points would cut the domain.
+fn boundary_flip_phase(
+    mesh: &mut TetMesh,
+    st: &mut StepState,
+    linear: bool,
+    report: &mut StepReport,
+) {
     let fp = st.first_face_point;
+    // The old corners opposite each old edge in the split faces.
+    let mut opposite: FastHashMap<[u32; 2], Vec<u32>> = FastHashMap::default();
+    if linear {
+        for &(f, _) in &st.split_faces {
+            for i in 0..3 {
+                opposite
+                    .entry(edge_key(f[i], f[(i + 1) % 3]))
+                    .or_default()
+                    .push(f[(i + 2) % 3]);
+            }
+        }
+    }
     // Old edges seen from the split faces, with how often and one face point.
     let mut seen: FastHashMap<[u32; 2], (u32, u8)> =
         FastHashMap::with_capacity_and_hasher(3 * st.split_faces.len() / 2, Default::default());
@@ -359,6 +387,19 @@ fn boundary_flip_phase(mesh: &mut TetMesh, st: &mut StepState, report: &mut Step
             if !same_marker {
                 report.refused_boundary_flips += 1;
                 continue;
+            }
+            if linear {
+                let coplanar = match opposite.get(&[a, b]).map(Vec::as_slice) {
+                    Some(&[c1, c2]) => {
+                        let [pa, pb, p1, p2] = [a, b, c1, c2].map(|v| mesh.point(v));
+                        crate::geom::orient3d(pa, pb, p1, p2) == 0.0
+                    }
+                    _ => false,
+                };
+                if !coplanar {
+                    report.refused_boundary_flips += 1;
+                    continue;
+                }
             }
             remove_edge(mesh, &ring, f64::NEG_INFINITY).map(|_| ())
         };

@@ -19,7 +19,7 @@
 mod angles;
 mod topology;
 
-use crate::geom::is_positive;
+use crate::geom::orient3d;
 use crate::mesh::{TetMesh, DEAD, NO_ADJ};
 use crate::topo::TET_FACES;
 use angles::{cosine_extremes, lanes, BinThresholds, LaneVec, LANES};
@@ -151,7 +151,8 @@ fn is_inverted(d: f64, edge_product: f64, corners: impl FnOnce() -> [DVec3; 4]) 
     if edge_product > 1e-250 && edge_product.is_finite() && d * d > 1e-26 * edge_product {
         d < 0.0
     } else {
-        !is_positive(&corners())
+        let p = corners();
+        orient3d(p[0], p[1], p[2], p[3]) <= 0.0
     }
 }
 

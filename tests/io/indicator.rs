@@ -100,6 +100,7 @@ fn write_all_formats(dir: &Path, mesh: &TetMesh, values: &[f64]) -> Vec<String> 
     write_vtu(
         &p,
         mesh,
+        None,
         &[CellArray::Float64("eta".into(), values.to_vec())],
     )
     .unwrap();

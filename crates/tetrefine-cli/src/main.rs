@@ -33,7 +33,10 @@ enum Command {
 }
 
 fn main() -> ExitCode {
+    tetrefine::io::install_signal_cleanup();
     let cli = Cli::parse();
+    // Every file the command writes appears at the end, together, or not at all.
+    let outputs = tetrefine::io::OutputSet::begin();
     let result = match cli.command {
         Command::Quality(a) => cli::quality::run(a),
         Command::Convert(a) => cli::convert::run(a),
@@ -43,6 +46,9 @@ fn main() -> ExitCode {
         Command::Mesh(a) => cli::mesh::run(a),
         Command::Bisect(a) => cli::bisect::run(a),
     };
+    let result = result
+        .and_then(|()| cli::outputs::finish_stdout())
+        .and_then(|()| outputs.commit().map_err(|e| e.to_string()));
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {

@@ -539,3 +539,77 @@ fn cli_bad_surfaces_fail_with_one_line_and_no_output() {
     assert!(!o.status.success());
     assert_eq!(String::from_utf8_lossy(&o.stderr).lines().count(), 1);
 }
+
+/// Issue 21: seeds outside the domain and hostile switches give clean
+/// one-line errors, never a crash of the process.
+#[test]
+fn outside_seeds_and_hostile_switches_are_refused_cleanly() {
+    use tetrefine::io::plc::Region;
+    for z in [2.0, 1e308] {
+        let mut plc = cube_plc();
+        plc.regions.push(Region {
+            point: [0.5, 0.5, z],
+            attribute: 3,
+            max_volume: None,
+        });
+        let e = tetrahedralize(&plc, &Options::default()).unwrap_err();
+        assert!(e.to_string().contains("outside the surface"), "{z}: {e}");
+    }
+    // Through the command line: a .poly whose only seed is outside.
+    let dir = tempfile::tempdir().unwrap();
+    let poly = dir.path().join("cube.poly");
+    let mut s = String::from("8 3 0 0\n");
+    for (i, p) in cube_points().iter().enumerate() {
+        s += &format!("{} {} {} {}\n", i + 1, p[0], p[1], p[2]);
+    }
+    s += "6 0\n";
+    for q in [
+        [1, 3, 4, 2],
+        [5, 6, 8, 7],
+        [1, 2, 6, 5],
+        [3, 7, 8, 4],
+        [1, 5, 7, 3],
+        [2, 4, 8, 6],
+    ] {
+        s += &format!("1\n4 {} {} {} {}\n", q[0], q[1], q[2], q[3]);
+    }
+    std::fs::write(dir.path().join("plain.poly"), format!("{s}0\n0\n")).unwrap();
+    s += "0\n1\n1 0.5 0.5 2 7\n";
+    std::fs::write(&poly, s).unwrap();
+    let out = dir.path().join("o.mesh");
+    let run = |extra: &[&str]| {
+        let input = if extra.is_empty() {
+            poly.clone()
+        } else {
+            dir.path().join("plain.poly")
+        };
+        let mut c = Command::new(env!("CARGO_BIN_EXE_tetrefine"));
+        c.args(["mesh", input.to_str().unwrap(), "-o", out.to_str().unwrap()]);
+        c.args(extra);
+        c.output().unwrap()
+    };
+    let o = run(&[]);
+    assert_eq!(
+        o.status.code(),
+        Some(1),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert!(String::from_utf8_lossy(&o.stderr).contains("outside the surface"));
+    assert!(o.stdout.is_empty() && !out.exists());
+    let long = "p".repeat(1024);
+    assert!(
+        run(&["--switches", "pq1.414"]).status.success(),
+        "the plain cube meshes"
+    );
+    std::fs::remove_file(&out).unwrap();
+    for sw in [long.as_str(), "q0.5", "q1.2/75", "a-1"] {
+        let o = run(&["--switches", sw]);
+        assert_eq!(o.status.code(), Some(1), "{sw}");
+        assert!(
+            String::from_utf8_lossy(&o.stderr).contains("switch"),
+            "{sw}"
+        );
+        assert!(!out.exists());
+    }
+}

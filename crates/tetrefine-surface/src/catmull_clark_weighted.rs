@@ -233,10 +233,9 @@ impl WeightedConfig {
     /// Reads a configuration from a JSON file; errors name the file and line.
     pub fn from_json_file(path: &Path) -> Result<WeightedConfig, IoError> {
         let bytes = tetrefine::file::read_bytes(path)?;
-        serde_json::from_slice(&bytes).map_err(|e| IoError {
-            path: path.to_path_buf(),
-            line: Some(e.line()).filter(|&l| l > 0),
-            message: format!("invalid weights file: {e}"),
+        serde_json::from_slice(&bytes).map_err(|e| {
+            let line = Some(e.line()).filter(|&l| l > 0);
+            IoError::decode(path, line, "invalid weights file", e)
         })
     }
 

@@ -93,10 +93,9 @@ pub fn load_surface(path: &Path) -> Result<PolyMesh, IoError> {
                 .face()
                 .and_then(|f| file.face_lines.get(f).copied())
                 .filter(|&l| l > 0);
-            Err(IoError {
-                path: path.to_path_buf(),
-                line: line.map(|l| l as usize),
-                message: e.to_string(),
+            Err(match line {
+                Some(l) => IoError::at(path, l as usize, e.to_string()),
+                None => IoError::file(path, e.to_string()),
             })
         }
     }

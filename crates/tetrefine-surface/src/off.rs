@@ -57,8 +57,20 @@ pub fn read(path: &Path) -> Result<SurfaceFile, IoError> {
         return Err(IoError::at(path, cline, "negative vertex or face count"));
     }
     let (nv, nf) = (nv as usize, nf as usize);
+    // A vertex line takes at least 6 bytes and a face line 8: counts the file
+    // cannot hold are refused before anything is allocated.
+    if nv.saturating_mul(6).saturating_add(nf.saturating_mul(8)) > text.len() {
+        return Err(IoError::at(
+            path,
+            cline,
+            format!(
+                "{nv} vertices and {nf} faces cannot fit in the {} bytes of the file (truncated or corrupt counts)",
+                text.len()
+            ),
+        ));
+    }
     let mut out = SurfaceFile::default();
-    out.mesh.points.reserve(nv.min(1 << 24));
+    out.mesh.points.reserve(nv);
     for i in 0..nv {
         let (l, s) = lines.next().ok_or_else(|| {
             IoError::at(
@@ -88,6 +100,14 @@ pub fn read(path: &Path) -> Result<SurfaceFile, IoError> {
                 path,
                 l,
                 format!("face has {k} vertices; a face needs at least 3"),
+            ));
+        }
+        // Each index takes at least two bytes of the line.
+        if k as u64 > s.len() as u64 / 2 + 1 {
+            return Err(IoError::at(
+                path,
+                l,
+                format!("face declares {k} vertices, more than its line can hold"),
             ));
         }
         let mut face = Vec::with_capacity(k as usize);

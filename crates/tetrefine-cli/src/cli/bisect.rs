@@ -34,5 +34,5 @@ pub fn run(a: Args) -> super::CliResult {
             mesh.n_tets() as f64 / secs.max(1e-9) / 1e6
         );
     }
-    tetrefine::io::write_mesh(&a.output, &mesh).map_err(|e| e.to_string())
+    super::write_mesh(&a.output, &mesh)
 }

@@ -15,5 +15,5 @@ pub struct Args {
 pub fn run(a: Args) -> super::CliResult {
     tetrefine::io::Format::for_writing(&a.output).map_err(|e| e.to_string())?;
     let mesh = super::load(&a.input)?;
-    tetrefine::io::write_mesh(&a.output, &mesh).map_err(|e| e.to_string())
+    super::write_mesh(&a.output, &mesh)
 }

@@ -42,5 +42,5 @@ pub fn run(a: Args) -> super::CliResult {
         report.optimized_moves,
         report.passes
     );
-    tetrefine::io::write_mesh(&a.output, &mesh).map_err(|e| e.to_string())
+    super::write_mesh(&a.output, &mesh)
 }

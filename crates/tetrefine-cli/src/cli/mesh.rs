@@ -53,7 +53,7 @@ pub fn run(a: Args) -> super::CliResult {
     tetrefine::tetgen::switches(&opts, false, "").map_err(|e| e.to_string())?;
     let plc = Plc::read(&a.input).map_err(|e| e.to_string())?;
     let mesh = tetrahedralize(&plc, &opts).map_err(|e| format!("{}: {e}", a.input.display()))?;
-    tetrefine::io::write_mesh(&a.output, &mesh).map_err(|e| e.to_string())?;
+    super::write_mesh(&a.output, &mesh)?;
     if let Some(want) = opts.min_dihedral {
         let worst = tetrefine::MeshStats::compute(&mesh).min_dihedral_deg.worst;
         if worst < want {

@@ -3,8 +3,10 @@
 
 pub mod bisect;
 pub mod convert;
+pub mod guard;
 pub mod improve;
 pub mod mesh;
+pub mod outputs;
 pub mod progress;
 pub mod quality;
 pub mod refine;
@@ -12,19 +14,18 @@ pub mod steps;
 pub mod surface;
 
 use std::path::Path;
-use tetrefine::io::vtk::CellArray;
+use tetrefine::io::vtk::{CellArray, VtuSummary};
 use tetrefine::report::histogram::{write_histogram as write_hist_file, HistogramFormat};
 use tetrefine::report::MeshStats;
 use tetrefine::TetMesh;
 
-/// `println!` that ignores a closed pipe (`tetrefine quality … | head`):
-/// standard output is a courtesy, the files are the product, and a reader
-/// that stopped early must not turn into a panic.
+/// `println!` that never panics: a failed write (a closed pipe, a full
+/// disk) is remembered and fails the command at its end, so that no output
+/// file appears and the exit status is non-zero.
 #[macro_export]
 macro_rules! say {
     ($($arg:tt)*) => {{
-        use std::io::Write as _;
-        let _ = writeln!(std::io::stdout().lock(), $($arg)*);
+        $crate::cli::outputs::say_line(format_args!($($arg)*));
     }};
 }
 
@@ -33,7 +34,13 @@ pub type CliResult = Result<(), String>;
 
 /// Loads a mesh, telling the user on stderr what building changed.
 pub fn load(path: &std::path::Path) -> Result<tetrefine::TetMesh, String> {
-    let (mesh, report) = tetrefine::io::load_mesh(path).map_err(|e| e.to_string())?;
+    let (mesh, report, notes) = tetrefine::io::load_mesh_noted(path).map_err(|e| e.to_string())?;
+    for n in notes {
+        eprintln!("note: {}: {n}", path.display());
+    }
+    if let Some(n) = guard::nonmanifold_note(&mesh) {
+        eprintln!("note: {}: {n}", path.display());
+    }
     if report.reoriented > 0 {
         eprintln!(
             "note: {}: {} tetrahedra were negatively oriented and have been turned around",
@@ -101,7 +108,32 @@ pub fn write_refined(
                 .iter()
                 .map(|(name, f)| CellArray::Int32With(name.to_string(), n, f)),
         );
-        tetrefine::io::vtk::write_vtu(path, mesh, &cells).map_err(|e| e.to_string())
+        let (valence, stats) = (MeshStats::vertex_valence(mesh), MeshStats::compute(mesh));
+        let summary = vtu_summary(&valence, &stats);
+        tetrefine::io::vtk::write_vtu(path, mesh, Some(&summary), &cells).map_err(|e| e.to_string())
+    } else {
+        tetrefine::io::write_mesh(path, mesh).map_err(|e| e.to_string())
+    }
+}
+
+/// The figures a `.vtu` carries besides the mesh, from the statistics.
+fn vtu_summary<'a>(valence: &'a [u32], stats: &'a MeshStats) -> VtuSummary<'a> {
+    VtuSummary {
+        valence,
+        histogram_counts: &stats.histogram.counts,
+        histogram_edges_deg: &stats.histogram.edges_deg,
+    }
+}
+
+/// Writes `mesh` in the format of `path`'s extension; a `.vtu` also gets the
+/// point valences and the minimum-dihedral histogram of the statistics.
+pub fn write_mesh(path: &Path, mesh: &TetMesh) -> CliResult {
+    let is_vtu = tetrefine::io::Format::for_writing(path).map_err(|e| e.to_string())?
+        == tetrefine::io::Format::Vtu;
+    if is_vtu {
+        let (valence, stats) = (MeshStats::vertex_valence(mesh), MeshStats::compute(mesh));
+        let summary = vtu_summary(&valence, &stats);
+        tetrefine::io::vtk::write_vtu(path, mesh, Some(&summary), &[]).map_err(|e| e.to_string())
     } else {
         tetrefine::io::write_mesh(path, mesh).map_err(|e| e.to_string())
     }

@@ -54,6 +54,10 @@ pub fn run(a: Args) -> super::CliResult {
     if let Some(o) = &a.output {
         tetrefine::io::Format::for_writing(o).map_err(|e| e.to_string())?;
     }
+    super::outputs::refuse_shared_paths(&[
+        ("-o", a.output.as_deref()),
+        ("--histogram", a.histogram.as_deref()),
+    ])?;
 
     let mesh = super::load(&a.input)?;
     let stats = MeshStats::compute_with(&mesh, Histogram::new(0.0, DEFAULT_HIST_MAX_DEG, a.bins));
@@ -63,13 +67,13 @@ pub fn run(a: Args) -> super::CliResult {
         crate::say!("{json}");
     } else {
         let name = file_name(&a.input);
-        print!("{}", format_table(&[(name.as_str(), &stats)]));
+        super::outputs::say_text(&format_table(&[(name.as_str(), &stats)]));
     }
 
     // The mesh first: its writer is the likelier to refuse (format support),
     // and then no file at all is left behind.
     if let Some(o) = &a.output {
-        tetrefine::io::write_mesh(o, &mesh).map_err(|e| e.to_string())?;
+        super::write_mesh(o, &mesh)?;
         eprintln!("wrote mesh {}", o.display());
     }
     if let Some(h) = &a.histogram {

@@ -92,6 +92,17 @@ pub struct Args {
     /// even global steps.
     #[arg(long, default_value_t = 0)]
     pub step_offset: usize,
+    /// Largest memory the refinement may take (bytes, or with K, M, G, T);
+    /// default: what /proc/meminfo says is available. Each step's peak is
+    /// estimated beforehand and a step that would not fit is refused.
+    #[arg(long, value_name = "SIZE")]
+    pub max_memory: Option<String>,
+    /// Accept a selection that matches no tet (the mesh is written unrefined).
+    #[arg(long)]
+    pub allow_empty: bool,
+    /// Accept `--steps 0` (the mesh is written unrefined, with its arrays).
+    #[arg(long)]
+    pub allow_steps_zero: bool,
 }
 
 /// Where the optimize phase may act in adaptive refinement.
@@ -138,6 +149,17 @@ fn mark_strategy(a: &Args) -> Result<Option<MarkStrategy>, String> {
 /// Runs `refine`.
 pub fn run(a: Args) -> super::CliResult {
     tetrefine::io::Format::for_writing(&a.output).map_err(|e| e.to_string())?;
+    super::outputs::refuse_shared_paths(&[
+        ("-o", Some(a.output.as_path())),
+        ("--stats", a.stats.as_deref()),
+        ("--histogram", a.histogram.as_deref()),
+        ("--features-out", a.features_out.as_deref()),
+        ("--parent-map", a.parent_map.as_deref()),
+    ])?;
+    if a.steps == 0 && !a.allow_steps_zero {
+        return Err("--steps 0 refines nothing; give --steps N ≥ 1 (or --allow-steps-zero to write the mesh unrefined)".into());
+    }
+    let budget = super::guard::MemoryBudget::new(a.max_memory.as_deref())?;
     if let Some(h) = &a.histogram {
         super::check_histogram_path(h)?;
     }
@@ -164,17 +186,30 @@ pub fn run(a: Args) -> super::CliResult {
                 Some(spec) => Some(read_indicator(spec, &input).map_err(|e| e.to_string())?),
                 None => None,
             };
+            super::guard::check_selection(st, &input)?;
             let sel =
                 select(st, values.as_deref(), &input).map_err(|e| format!("--mark {st}: {e}"))?;
-            eprintln!(
-                "selected {} of {} tets ({st})",
-                sel.iter().filter(|&&x| x).count(),
-                input.n_tets()
-            );
+            let count = sel.iter().filter(|&&x| x).count();
+            if count == 0 && !a.allow_empty {
+                return Err(format!(
+                    "--mark {st} selects none of the {} tets; nothing would be refined (--allow-empty writes the mesh unrefined)",
+                    input.n_tets()
+                ));
+            }
+            eprintln!("selected {count} of {} tets ({st})", input.n_tets());
             Some(sel)
         }
         None => None,
     };
+    let selected = selection
+        .as_ref()
+        .map_or(input.n_tets(), |s| s.iter().filter(|&&x| x).count()) as u64;
+    budget.check_plan(
+        a.steps,
+        input.n_tets() as u64,
+        selected,
+        input.n_tets() as u64,
+    )?;
     super::apply_feature_option(&mut input, &a.features, a.feature_angle)?;
     let mut mesh = input.clone();
     let opts = RefineOptions {

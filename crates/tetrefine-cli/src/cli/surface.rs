@@ -321,6 +321,14 @@ pub fn run(a: Args) -> super::CliResult {
         Scheme::Truncate => truncate_with(&mesh, a.steps, a.cut.unwrap_or(0.25)).map_err(ctx2)?,
         Scheme::Ifs => return run_ifs(&a),
     };
+    let input = a
+        .input
+        .as_ref()
+        .map_or_else(String::new, |p| format!("{}: ", p.display()));
+    super::guard::check_surface_output(
+        &out,
+        &format!("{input}{}", format!("{:?}", a.scheme).to_lowercase()),
+    )?;
     write_surface(&a.output, &out).map_err(|e| e.to_string())?;
     eprintln!(
         "wrote {}: {} vertices, {} edges, {} faces, Euler characteristic {}",

@@ -29,12 +29,23 @@ const CASES: &[(&str, Option<usize>, &str)] = &[
     ("bad_base64.vtu", Some(6), "base64"),
     ("truncated.vtu", Some(7), "truncated"),
     ("garbage.vtu", Some(1), "not a text file"),
+    // Issue 21: a line of mmg_cube.vtu's raw appended data duplicated.
+    (
+        "duplicated_line_appended.vtu",
+        Some(30),
+        "DataArray 'offsets'",
+    ),
     ("unknown_extension.xyz", None, "extension"),
 ];
 
 /// Files of tests/bad/ that are not inputs of their own (`indicator/` holds
 /// the malformed indicator files of tests/indicator.rs).
-const SIBLINGS: &[&str] = &["README.md", "index_out_of_range.node", "indicator"];
+const SIBLINGS: &[&str] = &[
+    "README.md",
+    "index_out_of_range.node",
+    "indicator",
+    "surface",
+];
 
 fn bad_dir() -> std::path::PathBuf {
     crate::support::root().join("tests/bad")

@@ -13,6 +13,7 @@ mod determinism;
 mod mesh_without_tetgen;
 mod quality;
 mod refine;
+mod strict;
 mod surface;
 
 use std::process::Command;

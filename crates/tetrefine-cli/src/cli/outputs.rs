@@ -1,0 +1,80 @@
+//! A command's outputs as one unit: every file is written to a temporary
+//! file and renamed only when the command and its standard output both
+//! succeeded ([`tetrefine::io::OutputSet`]); two outputs on one path are
+//! refused before any work; a failed write to standard output (a full disk,
+//! a closed descriptor, a reader that went away) makes the command fail.
+
+use std::io::Write;
+use std::path::Path;
+use std::sync::Mutex;
+
+/// The first failed write to standard output, if any.
+static STDOUT_ERROR: Mutex<Option<String>> = Mutex::new(None);
+
+/// Writes one line to standard output; a failure is remembered and fails
+/// the command at its end ([`finish_stdout`]).
+pub fn say_line(args: std::fmt::Arguments<'_>) {
+    let mut out = std::io::stdout().lock();
+    if let Err(e) = out.write_fmt(args).and_then(|()| out.write_all(b"\n")) {
+        record(e);
+    }
+}
+
+/// Writes text to standard output as it is (see [`say_line`]).
+pub fn say_text(text: &str) {
+    if let Err(e) = std::io::stdout().lock().write_all(text.as_bytes()) {
+        record(e);
+    }
+}
+
+fn record(e: std::io::Error) {
+    let mut g = STDOUT_ERROR.lock().unwrap_or_else(|p| p.into_inner());
+    if g.is_none() {
+        *g = Some(e.to_string());
+    }
+}
+
+/// Flushes standard output; `Err` if any write to it failed.
+pub fn finish_stdout() -> super::CliResult {
+    if let Err(e) = std::io::stdout().lock().flush() {
+        record(e);
+    }
+    match STDOUT_ERROR
+        .lock()
+        .unwrap_or_else(|p| p.into_inner())
+        .take()
+    {
+        Some(e) => Err(format!("cannot write to standard output: {e}")),
+        None => Ok(()),
+    }
+}
+
+/// Refuses two outputs on one file (`-o x --stats x`, or the same file by
+/// two spellings), naming both options.
+pub fn refuse_shared_paths(outputs: &[(&str, Option<&Path>)]) -> super::CliResult {
+    let key = |p: &Path| {
+        let dir = p
+            .parent()
+            .filter(|d| !d.as_os_str().is_empty())
+            .unwrap_or(Path::new("."));
+        (
+            std::fs::canonicalize(dir).unwrap_or_else(|_| dir.to_path_buf()),
+            p.file_name().map(|n| n.to_os_string()),
+        )
+    };
+    let given: Vec<(&str, &Path)> = outputs
+        .iter()
+        .filter_map(|&(opt, p)| p.map(|p| (opt, p)))
+        .collect();
+    for (i, &(a, pa)) in given.iter().enumerate() {
+        for &(b, pb) in &given[..i] {
+            if pa == pb || key(pa) == key(pb) {
+                return Err(format!(
+                    "{b} and {a} both name {}: give each output its own file",
+                    pa.display()
+                ));
+            }
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,228 @@
+use super::*;
+
+/// An axis-aligned box as six quadrilaterals, marker = face number; the
+/// face orientations are deliberately mixed.
+fn add_box(plc: &mut Plc, lo: [f64; 3], hi: [f64; 3]) {
+    let base = plc.points.len() as u32;
+    for i in 0..8 {
+        plc.points.push([
+            if i & 1 == 0 { lo[0] } else { hi[0] },
+            if i & 2 == 0 { lo[1] } else { hi[1] },
+            if i & 4 == 0 { lo[2] } else { hi[2] },
+        ]);
+    }
+    let quads = [
+        [0, 2, 3, 1],
+        [4, 5, 7, 6],
+        [0, 4, 5, 1], // inward
+        [2, 6, 7, 3],
+        [0, 2, 6, 4], // inward
+        [1, 3, 7, 5],
+    ];
+    for (m, q) in quads.iter().enumerate() {
+        plc.facets.push(Facet {
+            polygons: vec![q.iter().map(|&v| base + v).collect()],
+            holes: Vec::new(),
+            marker: m as i32 + 1,
+        });
+    }
+}
+
+fn unit_cube() -> Plc {
+    let mut p = Plc::default();
+    add_box(&mut p, [0.0; 3], [1.0; 3]);
+    p
+}
+
+#[test]
+fn cube_encloses_one() {
+    let v = unit_cube().analyze().unwrap();
+    assert!((v.enclosed - 1.0).abs() < 1e-14, "{v:?}");
+    assert_eq!(v.cells, 1);
+}
+
+#[test]
+fn cube_from_triangles_encloses_one() {
+    let c = unit_cube();
+    let mut tris = Vec::new();
+    for f in &c.facets {
+        let q = &f.polygons[0];
+        tris.push(([q[0], q[1], q[2]], f.marker));
+        tris.push(([q[0], q[2], q[3]], f.marker));
+    }
+    let t = Plc::from_triangles(c.points.clone(), &tris);
+    assert!((t.enclosed_volume().unwrap() - 1.0).abs() < 1e-14);
+}
+
+#[test]
+fn nested_box_is_a_second_cell_unless_a_hole_empties_it() {
+    let mut p = unit_cube();
+    add_box(&mut p, [0.25; 3], [0.75; 3]);
+    let v = p.analyze().unwrap();
+    assert_eq!(v.cells, 2);
+    assert!((v.enclosed - 1.0).abs() < 1e-14, "{v:?}");
+    p.holes.push([0.5; 3]);
+    let v = p.analyze().unwrap();
+    assert_eq!(v.hole_cells, 1);
+    assert!((v.enclosed - (1.0 - 0.125)).abs() < 1e-14, "{v:?}");
+    // A hole outside everything changes nothing.
+    p.holes[0] = [5.0, 5.0, 5.0];
+    assert!((p.enclosed_volume().unwrap() - 1.0).abs() < 1e-14);
+    // A hole in the outer cell leaves the inner box.
+    p.holes[0] = [0.1, 0.1, 0.1];
+    assert!((p.enclosed_volume().unwrap() - 0.125).abs() < 1e-14);
+}
+
+#[test]
+fn inner_wall_splits_a_box_into_two_cells() {
+    // Box [0,2]x[0,1]x[0,1] as two unit cubes sharing the face x = 1.
+    let mut p = Plc::default();
+    for i in 0..12 {
+        p.points
+            .push([(i % 3) as f64, ((i / 3) % 2) as f64, (i / 6) as f64]);
+    }
+    let id = |x: u32, y: u32, z: u32| x + 3 * y + 6 * z;
+    let mut quad = |q: [u32; 4], m: i32| {
+        p.facets.push(Facet {
+            polygons: vec![q.to_vec()],
+            holes: vec![],
+            marker: m,
+        })
+    };
+    for x in 0..2 {
+        quad(
+            [id(x, 0, 0), id(x + 1, 0, 0), id(x + 1, 1, 0), id(x, 1, 0)],
+            1,
+        );
+        quad(
+            [id(x, 0, 1), id(x + 1, 0, 1), id(x + 1, 1, 1), id(x, 1, 1)],
+            2,
+        );
+        quad(
+            [id(x, 0, 0), id(x + 1, 0, 0), id(x + 1, 0, 1), id(x, 0, 1)],
+            3,
+        );
+        quad(
+            [id(x, 1, 0), id(x + 1, 1, 0), id(x + 1, 1, 1), id(x, 1, 1)],
+            4,
+        );
+    }
+    for x in 0..3 {
+        quad([id(x, 0, 0), id(x, 1, 0), id(x, 1, 1), id(x, 0, 1)], 5);
+    }
+    let v = p.analyze().unwrap();
+    assert_eq!(v.cells, 2);
+    assert!((v.enclosed - 2.0).abs() < 1e-14, "{v:?}");
+    p.holes.push([1.5, 0.5, 0.5]);
+    assert!((p.enclosed_volume().unwrap() - 1.0).abs() < 1e-14);
+}
+
+#[test]
+fn disjoint_boxes_add_up() {
+    let mut p = unit_cube();
+    add_box(&mut p, [2.0, 0.0, 0.0], [3.0, 2.0, 1.0]);
+    assert!((p.enclosed_volume().unwrap() - 3.0).abs() < 1e-14);
+}
+
+#[test]
+fn open_box_is_rejected() {
+    let mut p = unit_cube();
+    p.facets.pop();
+    assert!(matches!(p.validate(), Err(PlcError::Open { .. })));
+}
+
+#[test]
+fn duplicated_facet_is_rejected() {
+    let mut p = unit_cube();
+    let f = p.facets[2].clone();
+    p.facets.push(f);
+    assert_eq!(
+        p.validate(),
+        Err(PlcError::DuplicateFacet { facet: 7, other: 3 })
+    );
+}
+
+#[test]
+fn degenerate_inputs_are_rejected() {
+    let mut p = unit_cube();
+    p.points[3][1] = f64::NAN;
+    assert!(matches!(
+        p.validate(),
+        Err(PlcError::NonFinite { point: 4, .. })
+    ));
+
+    let mut p = unit_cube();
+    p.facets[1].polygons[0][2] = 99;
+    assert!(matches!(
+        p.validate(),
+        Err(PlcError::IndexOutOfRange {
+            facet: 2,
+            index: 100,
+            ..
+        })
+    ));
+
+    let mut p = unit_cube();
+    for q in &mut p.points {
+        q[2] = 0.0;
+    }
+    assert_eq!(p.validate(), Err(PlcError::Flat { axis: 'z' }));
+
+    // All points on the tilted plane x + y + z = 1.5.
+    let mut p = unit_cube();
+    for q in &mut p.points {
+        q[2] = 1.5 - q[0] - q[1];
+    }
+    assert_eq!(p.validate(), Err(PlcError::Coplanar));
+
+    let mut p = unit_cube();
+    p.facets[0].polygons[0] = vec![0, 2, 2, 1];
+    assert!(matches!(
+        p.validate(),
+        Err(PlcError::BadFacet { facet: 1, .. })
+    ));
+
+    let mut p = unit_cube();
+    p.points[7] = [1.0, 1.0, 1.3];
+    assert!(matches!(p.validate(), Err(PlcError::BadFacet { .. })));
+}
+
+#[test]
+fn interpenetrating_boxes_are_rejected() {
+    let mut p = unit_cube();
+    add_box(&mut p, [0.5; 3], [1.5; 3]);
+    let e = p.validate().unwrap_err();
+    assert!(matches!(e, PlcError::Intersect { .. }), "{e}");
+    // A box poking through another's face, sharing no point with it.
+    let mut p = unit_cube();
+    add_box(&mut p, [0.25, 0.25, 0.5], [0.75, 0.75, 1.5]);
+    let e = p.validate().unwrap_err();
+    assert!(matches!(e, PlcError::Intersect { .. }), "{e}");
+}
+
+#[test]
+fn seeds_on_a_facet_are_rejected() {
+    let mut p = unit_cube();
+    p.holes.push([0.5, 0.5, 1.0]);
+    assert!(matches!(p.validate(), Err(PlcError::SeedOnFacet { .. })));
+}
+
+#[test]
+fn merging_coincident_points_renumbers_facets() {
+    let c = unit_cube();
+    let mut tris = Vec::new();
+    let mut points = Vec::new();
+    for f in &c.facets {
+        let q = &f.polygons[0];
+        for t in [[q[0], q[1], q[2]], [q[0], q[2], q[3]]] {
+            let b = points.len() as u32;
+            points.extend(t.iter().map(|&v| c.points[v as usize]));
+            tris.push(([b, b + 1, b + 2], 0));
+        }
+    }
+    let mut p = Plc::from_triangles(points, &tris);
+    assert_eq!(p.points.len(), 36);
+    p.merge_coincident_points();
+    assert_eq!(p.points.len(), 8);
+    assert!((p.enclosed_volume().unwrap() - 1.0).abs() < 1e-14);
+}
