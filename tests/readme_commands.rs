@@ -71,8 +71,7 @@ fn the_first_command_refines_a_mesh_into_a_vtu_and_a_png_and_the_second_is_quali
     // The tets of the last step, from the table the command printed.
     let tets: usize = table
         .lines()
-        .filter(|l| l.starts_with("step "))
-        .last()
+        .rfind(|l| l.starts_with("step "))
         .and_then(|l| l.split_whitespace().nth(4))
         .and_then(|w| w.replace(',', "").parse().ok())
         .unwrap_or_else(|| panic!("no step row with a tet count in\n{table}"));

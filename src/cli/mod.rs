@@ -32,7 +32,15 @@ pub type CliResult = Result<(), String>;
 
 /// Loads a mesh, telling the user on stderr what building changed.
 pub fn load(path: &std::path::Path) -> Result<tetrefine::TetMesh, String> {
-    let (mesh, report) = tetrefine::io::load_mesh(path).map_err(|e| e.to_string())?;
+    load_with_meta(path).map(|(m, _)| m)
+}
+
+/// [`load`] with the file's side table (physical names, tag lists, fields).
+pub fn load_with_meta(
+    path: &std::path::Path,
+) -> Result<(tetrefine::TetMesh, tetrefine::io::meta::MeshMeta), String> {
+    let (mesh, report, meta) =
+        tetrefine::io::load_mesh_with_meta(path).map_err(|e| e.to_string())?;
     if report.reoriented > 0 {
         eprintln!(
             "note: {}: {} tetrahedra were negatively oriented and have been turned around",
@@ -48,7 +56,7 @@ pub fn load(path: &std::path::Path) -> Result<tetrefine::TetMesh, String> {
             report.dropped_edges
         );
     }
-    Ok(mesh)
+    Ok((mesh, meta))
 }
 
 /// Checks a histogram path's extension before any work is done.
@@ -69,11 +77,14 @@ pub type TetValue<'a> = dyn Fn(&TetMesh, u32) -> i32 + Sync + 'a;
 
 /// Writes a refined mesh: compacted, and for `.vtu` with the cell arrays
 /// `level` and `parent` (plus `extra`, named integers per tet) besides the
-/// standard quality arrays.
+/// standard quality arrays; other formats get the input's side table `meta`
+/// (physical names and tags) and the write `options` (the MSH variant).
 pub fn write_refined(
     path: &Path,
     mesh: &mut TetMesh,
     extra: &[(&str, &TetValue<'_>)],
+    meta: &tetrefine::io::meta::MeshMeta,
+    options: &tetrefine::io::WriteOptions,
 ) -> CliResult {
     mesh.compact();
     let is_vtu = path
@@ -102,7 +113,7 @@ pub fn write_refined(
         );
         tetrefine::io::vtk::write_vtu(path, mesh, &cells).map_err(|e| e.to_string())
     } else {
-        tetrefine::io::write_mesh(path, mesh).map_err(|e| e.to_string())
+        tetrefine::io::write_mesh_with(path, mesh, meta, options).map_err(|e| e.to_string())
     }
 }
 

@@ -10,6 +10,7 @@ pub mod gid;
 pub mod gmsh;
 pub mod indicator;
 pub mod medit;
+pub mod meta;
 pub mod off;
 pub mod plc;
 pub mod poly;
@@ -180,6 +181,50 @@ pub fn load_mesh(path: &Path) -> Result<(TetMesh, crate::mesh::BuildReport), IoE
         line: e.line().map(|l| l as usize),
         message: e.to_string(),
     })
+}
+
+/// Reads a mesh with its side table ([`meta::MeshMeta`]: Gmsh physical names
+/// and tag lists, point and cell arrays); formats without one give an empty
+/// table.
+pub fn read_mesh_with_meta(path: &Path) -> Result<(MeshData, meta::MeshMeta), IoError> {
+    match Format::for_reading(path)? {
+        Format::Gmsh => gmsh::read_with_meta(path),
+        _ => Ok((read_mesh(path)?, meta::MeshMeta::default())),
+    }
+}
+
+/// [`load_mesh`] with the side table of [`read_mesh_with_meta`].
+pub fn load_mesh_with_meta(
+    path: &Path,
+) -> Result<(TetMesh, crate::mesh::BuildReport, meta::MeshMeta), IoError> {
+    let (data, meta) = read_mesh_with_meta(path)?;
+    let (mesh, report) = TetMesh::from_data(&data).map_err(|e| IoError {
+        path: path.to_path_buf(),
+        line: e.line().map(|l| l as usize),
+        message: e.to_string(),
+    })?;
+    Ok((mesh, report, meta))
+}
+
+/// How [`write_mesh_with`] writes what the extension leaves open.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct WriteOptions {
+    /// The MSH variant of a `.msh` output.
+    pub msh_format: gmsh::MshFormat,
+}
+
+/// [`write_mesh`] with a side table: Gmsh output gets its physical names,
+/// tag lists and fields (`$NodeData`, `$ElementData`) back.
+pub fn write_mesh_with(
+    path: &Path,
+    mesh: &TetMesh,
+    meta: &meta::MeshMeta,
+    options: &WriteOptions,
+) -> Result<(), IoError> {
+    match Format::for_writing(path)? {
+        Format::Gmsh => gmsh::write_with(path, mesh, meta, options.msh_format),
+        _ => write_mesh(path, mesh),
+    }
 }
 
 /// Writes `mesh` in the format given by the extension of `path`.
