@@ -10,8 +10,10 @@ mod adaptive;
 mod bad_input;
 mod bisect;
 mod determinism;
+mod gmsh_tags;
 mod mesh_without_tetgen;
 mod quality;
+mod readme_commands;
 mod refine;
 mod surface;
 

@@ -3,14 +3,13 @@
 //! independent reader) and a PNG histogram (decoded by `image`); the second
 //! is `quality`.
 
-use std::path::{Path, PathBuf};
-use std::process::Command;
+use crate::support;
+use std::path::Path;
 
 /// The `cargo run --release -- …` lines of the README's first `sh` block,
 /// as argument lists after the `--`.
 fn readme_commands() -> Vec<Vec<String>> {
-    let readme = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("README.md"))
-        .expect("README.md");
+    let readme = std::fs::read_to_string(support::path("README.md")).expect("README.md");
     let block = readme
         .split("```sh\n")
         .nth(1)
@@ -26,7 +25,7 @@ fn readme_commands() -> Vec<Vec<String>> {
 /// Runs one README command with the repository's `meshes/` as input and
 /// every output in `dir`.
 fn run_in(dir: &Path, args: &[String]) -> std::process::Output {
-    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    let root = support::root();
     let args: Vec<String> = args
         .iter()
         .map(|a| {
@@ -37,7 +36,7 @@ fn run_in(dir: &Path, args: &[String]) -> std::process::Output {
             }
         })
         .collect();
-    let o = Command::new(env!("CARGO_BIN_EXE_tetrefine"))
+    let o = crate::tetrefine_command()
         .args(&args)
         .current_dir(dir)
         .output()

@@ -5,14 +5,17 @@
 //! physical groups are known in closed form. (Gmsh's own reader checks the
 //! written files in CI: `tests/gmsh_roundtrip.py`.)
 
+use crate::support;
 use std::collections::{BTreeMap, BTreeSet};
-use std::path::Path;
-use std::process::Command;
+use std::path::{Path, PathBuf};
 use tetrefine::io::meta::MeshMeta;
 use tetrefine::io::{load_mesh_with_meta, read_mesh_with_meta};
 use tetrefine::mesh::MeshData;
 
-const DATA: &str = "tests/data";
+/// A file of `tests/data`.
+fn data(name: &str) -> PathBuf {
+    support::path(&format!("tests/data/{name}"))
+}
 
 fn names() -> BTreeMap<(i32, i32), String> {
     [
@@ -107,7 +110,7 @@ fn point_and_curve_tags(d: &MeshData, meta: &MeshMeta) -> (usize, usize) {
 
 /// Elements per (element type, physical tag) in a Gmsh MSH 2.2 ASCII file,
 /// counted from its raw lines (Gmsh writes an element once per group).
-fn raw_v22_counts(path: &str) -> BTreeMap<(i64, i64), usize> {
+fn raw_v22_counts(path: &Path) -> BTreeMap<(i64, i64), usize> {
     let text = std::fs::read_to_string(path).unwrap();
     let body = text
         .split("$Elements\n")
@@ -126,14 +129,14 @@ fn raw_v22_counts(path: &str) -> BTreeMap<(i64, i64), usize> {
 
 #[test]
 fn the_three_layouts_gmsh_wrote_give_every_name_and_every_tag_of_an_entity() {
-    let raw = raw_v22_counts(&format!("{DATA}/gmsh_tagged_v22.msh"));
+    let raw = raw_v22_counts(&data("gmsh_tagged_v22.msh"));
     let mut tets = None;
     for f in [
         "gmsh_tagged_v22.msh",
         "gmsh_tagged_v41.msh",
         "gmsh_tagged_v41_binary.msh",
     ] {
-        let (d, meta) = read_mesh_with_meta(&Path::new(DATA).join(f)).unwrap();
+        let (d, meta) = read_mesh_with_meta(&data(f)).unwrap();
         assert_eq!(meta.physical_names, names(), "{f}");
         // Every tet is in "all solids" and in exactly one of the two metals,
         // as many as Gmsh wrote in each group.
@@ -164,16 +167,13 @@ fn the_three_layouts_gmsh_wrote_give_every_name_and_every_tag_of_an_entity() {
 }
 
 fn tetrefine(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_tetrefine"))
-        .args(args)
-        .output()
-        .unwrap()
+    crate::tetrefine_command().args(args).output().unwrap()
 }
 
 #[test]
 fn names_and_every_tag_survive_refine_and_convert_in_each_msh_format() {
     let dir = tempfile::tempdir().unwrap();
-    let input = format!("{DATA}/gmsh_tagged_v41.msh");
+    let input = data("gmsh_tagged_v41.msh").to_string_lossy().into_owned();
     let (_, input_meta) = read_mesh_with_meta(Path::new(&input)).unwrap();
     for format in ["2.2", "4.1", "4.1-binary"] {
         for cmd in ["refine", "convert"] {
@@ -228,7 +228,7 @@ fn names_and_every_tag_survive_refine_and_convert_in_each_msh_format() {
 
 /// A copy of the 4.1 ASCII fixture with `edit` applied to its text.
 fn edited(dir: &Path, name: &str, edit: impl Fn(&str) -> String) -> std::path::PathBuf {
-    let text = std::fs::read_to_string(format!("{DATA}/gmsh_tagged_v41.msh")).unwrap();
+    let text = std::fs::read_to_string(data("gmsh_tagged_v41.msh")).unwrap();
     let p = dir.join(name);
     std::fs::write(&p, edit(&text)).unwrap();
     p
