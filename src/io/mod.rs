@@ -6,10 +6,12 @@
 //! the file and, where there is one, the line. Writers go through
 //! [`write_atomic`], so a failed write never leaves a partial file behind.
 
+pub mod fields;
 pub mod gid;
 pub mod gmsh;
 pub mod indicator;
 pub mod medit;
+pub mod meshb;
 pub mod meta;
 pub mod off;
 pub mod plc;
@@ -36,6 +38,8 @@ use std::path::Path;
 pub enum Format {
     /// Medit / MMG `.mesh` (ASCII).
     Medit,
+    /// Medit / MMG binary `.meshb` (libMeshb versions 1–4; writes version 2).
+    Meshb,
     /// Gmsh `.msh`, 2.2 or 4.1, ASCII or binary (writes 4.1 ASCII).
     Gmsh,
     /// GiD `.msh` (reads only).
@@ -58,6 +62,7 @@ impl Format {
     pub fn for_reading(path: &Path) -> Result<Format, IoError> {
         match extension(path).as_str() {
             "mesh" => Ok(Format::Medit),
+            "meshb" => Ok(Format::Meshb),
             "vtu" => Ok(Format::Vtu),
             "node" | "ele" | "face" | "edge" => Ok(Format::Tetgen),
             "msh" => {
@@ -85,11 +90,11 @@ impl Format {
             }
             "" => Err(IoError::file(
                 path,
-                "has no extension; use .mesh, .msh, .vtu, .node or .ele",
+                "has no extension; use .mesh, .meshb, .msh, .vtu, .node or .ele",
             )),
             other => Err(IoError::file(
                 path,
-                format!("unknown mesh extension '.{other}'; use .mesh, .msh, .vtu, .node or .ele"),
+                format!("unknown mesh extension '.{other}'; use .mesh, .meshb, .msh, .vtu, .node or .ele"),
             )),
         }
     }
@@ -98,12 +103,13 @@ impl Format {
     pub fn for_writing(path: &Path) -> Result<Format, IoError> {
         match extension(path).as_str() {
             "mesh" => Ok(Format::Medit),
+            "meshb" => Ok(Format::Meshb),
             "vtu" => Ok(Format::Vtu),
             "msh" => Ok(Format::Gmsh),
             "node" | "ele" => Ok(Format::Tetgen),
             other => Err(IoError::file(
                 path,
-                format!("cannot write '.{other}'; use .mesh, .msh (Gmsh 4.1), .vtu or .node/.ele (TetGen)"),
+                format!("cannot write '.{other}'; use .mesh, .meshb, .msh (Gmsh), .vtu or .node/.ele (TetGen)"),
             )),
         }
     }
@@ -113,6 +119,7 @@ impl Format {
 pub fn read_mesh(path: &Path) -> Result<MeshData, IoError> {
     match Format::for_reading(path)? {
         Format::Medit => medit::read(path),
+        Format::Meshb => meshb::read(path),
         Format::Gmsh => gmsh::read(path),
         Format::Gid => gid::read(path),
         Format::Vtu => vtk::read(path),
@@ -178,6 +185,7 @@ pub fn write_mesh_with(
 pub fn write_mesh(path: &Path, mesh: &TetMesh) -> Result<(), IoError> {
     match Format::for_writing(path)? {
         Format::Medit => medit::write(path, mesh),
+        Format::Meshb => meshb::write(path, mesh, 2),
         Format::Gmsh => gmsh::write(path, mesh),
         Format::Vtu => vtk::write_vtu(path, mesh, &[]),
         Format::Tetgen => tetgen::write(path, mesh),

@@ -11,6 +11,7 @@ mod bad_input;
 mod bisect;
 mod determinism;
 mod gmsh_tags;
+mod medit_meshb;
 mod mesh_without_tetgen;
 mod quality;
 mod readme_commands;
