@@ -25,7 +25,8 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
-#![warn(missing_docs)]
+#![deny(missing_docs)]
+#![warn(clippy::undocumented_unsafe_blocks)]
 
 pub mod file;
 pub mod geom;
@@ -33,8 +34,10 @@ pub mod improve;
 pub mod io;
 pub mod mesh;
 pub mod ops;
+pub mod polyline;
 pub mod refine;
 pub mod report;
+pub mod rng;
 pub mod stencil;
 #[cfg(feature = "tetgen")]
 pub mod tetgen;

@@ -22,7 +22,7 @@
 //! * `sin θ = D |v_j - v_i| / (|n_k| |n_l|)`  (the `3V·ℓ / (2 A_k A_l)` identity)
 //!
 //! The second form keeps the sign of `D`, so it is the *signed* sine that the
-//! seed paper (Burkhart, Hamann and Umlauf, "Adaptive and feature-preserving
+//! √3 paper (Burkhart, Hamann and Umlauf, "Adaptive and feature-preserving
 //! subdivision for high-quality tetrahedral meshes", §2.3) uses as its quality:
 //! the minimum over the six edges, 0.9428 (= sin 70.53°) for the regular tet,
 //! negative for an inverted one.

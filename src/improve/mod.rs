@@ -1,5 +1,5 @@
 //! Mesh improvement: vertex smoothing (Laplacian, then optimization-based) and
-//! interior edge removal, as in §3.2 of the seed paper.
+//! interior edge removal, as in §3.2 of the √3 paper (Burkhart, Hamann and Umlauf).
 //!
 //! The objective everywhere is the paper's quality: the minimum signed sine of
 //! the dihedral angles of a tet, and for a vertex the minimum over its ball.
@@ -10,7 +10,7 @@ pub mod optimize;
 pub mod passes;
 pub mod ring;
 
-pub use passes::{fixed_vertices, improve, ImproveOptions, ImproveReport};
+pub use passes::{improve, ImproveOptions, ImproveReport};
 
 use crate::geom::{all_positive, tet_min_sine};
 use crate::mesh::{tet_points_with, TetMesh};

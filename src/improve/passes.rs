@@ -1,4 +1,4 @@
-//! The `optimize` phase (seed paper §3.2, steps 6–7): passes of interior edge
+//! The `optimize` phase (the √3 paper, §3.2, steps 6–7): passes of interior edge
 //! removal where it raises the worst tet of the edge's ring, then vertex
 //! smoothing where a vertex's worst tet is below a threshold — Laplacian
 //! first, kept only if it helps, then optimization-based smoothing —
@@ -12,15 +12,16 @@
 use super::colour::{colour_balls_except, sequential_levels, Balls};
 use super::laplacian::{laplacian_position_in, BallNow};
 use super::optimize::{optimize_position_in, OptimizeParams};
-use super::ring::{canonicalize_ring, improving_ring_triangulation, RingScratch};
+use super::ring::canonicalize_ring;
 use super::BallPoints;
 use crate::geom::tet_min_sine;
 use crate::mesh::fasthash::{FastHashMap, FastHashSet};
-use crate::mesh::{edge_key, EdgeKey, TetMesh, NO_ADJ};
+use crate::mesh::{edge_key, EdgeKey, TetMesh};
 use crate::ops::edge_removal::{apply_ring_triangulation, RingTriangulation};
+use crate::ops::edge_removal::{best_ring_triangulation_above, RingScratch};
 use crate::ops::EdgeRing;
 use crate::topo::scatter::Disjoint;
-use crate::topo::TET_EDGES;
+use crate::topo::{EDGE_OF, TET_EDGES};
 use glam::DVec3;
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicBool, AtomicU8, Ordering};
@@ -79,32 +80,6 @@ pub struct ImproveReport {
     pub laplacian_moves: usize,
     /// Vertices moved by optimization-based smoothing.
     pub optimized_moves: usize,
-}
-
-/// Vertices that must not move: on the boundary, on a face between two
-/// regions or a marked face, on a feature edge, corners and required ones.
-pub fn fixed_vertices(mesh: &TetMesh) -> Vec<bool> {
-    let mut fixed = vec![false; mesh.n_points()];
-    for t in mesh.tet_ids() {
-        let adj = mesh.adj(t);
-        for (f, &h) in adj.iter().enumerate() {
-            let constrained = h == NO_ADJ || mesh.region(h >> 2) != mesh.region(t);
-            let fv = mesh.face_vertices(t, f);
-            if constrained || (!mesh.face_markers().is_empty() && mesh.face_marker(fv).is_some()) {
-                for v in fv {
-                    fixed[v as usize] = true;
-                }
-            }
-        }
-    }
-    for e in mesh.feature_edges().keys() {
-        fixed[e[0] as usize] = true;
-        fixed[e[1] as usize] = true;
-    }
-    for &v in mesh.corners().iter().chain(mesh.required_vertices()) {
-        fixed[v as usize] = true;
-    }
-    fixed
 }
 
 /// Work-tracking state of [`improve`]: per-slot quality and dirty flags, so
@@ -172,9 +147,6 @@ impl Tracker {
     }
 }
 
-/// Local edge index (into [`TET_EDGES`]) of local vertices `i != j`.
-const EDGE_OF: [[u8; 4]; 4] = [[6, 0, 1, 2], [0, 6, 3, 4], [1, 3, 6, 5], [2, 4, 5, 6]];
-
 /// Runs the optimisation passes on `mesh`.
 ///
 /// The edge search and vertex smoothing run in parallel: edges are searched
@@ -183,7 +155,7 @@ const EDGE_OF: [[u8; 4]; 4] = [[6, 0, 1, 2], [0, 6, 3, 4], [1, 3, 6, 5], [2, 4, 
 /// parallel (see [`super::colour`]). The result does not depend on the
 /// number of threads.
 pub fn improve(mesh: &mut TetMesh, opts: &ImproveOptions) -> ImproveReport {
-    let fixed = fixed_vertices(mesh);
+    let fixed = mesh.fixed_vertices();
     let movable: Vec<bool> = (0..mesh.n_points())
         .map(|v| {
             !fixed[v]
@@ -268,7 +240,7 @@ impl EdgeRemoval {
     ///
     /// The search runs in parallel on the mesh as it stands: every edge of a
     /// candidate tet whose closed ring can be re-triangulated with a better
-    /// worst tet (see [`improving_ring_triangulation`]) is recorded with its
+    /// worst tet (see [`best_ring_triangulation_above`]) is recorded with its
     /// triangulation. Whichever thread finds an edge, its ring is put in
     /// canonical form first ([`canonicalize_ring`]), so the records do not
     /// depend on the threads. The removals are then made one by one, visiting
@@ -456,7 +428,9 @@ fn judge_ring(
         .map(|&u| tr.tq[u as usize])
         .fold(f64::INFINITY, f64::min);
     canonicalize_ring(ring);
-    improving_ring_triangulation(mesh, ring, worst + 1e-12, &mut s.dp)
+    let bar = worst + 1e-12;
+    let tri = best_ring_triangulation_above(mesh, ring, bar, &mut s.dp);
+    (tri.quality > bar).then_some(tri)
 }
 
 /// The search half of [`EdgeRemoval::pass`] for the edges of candidate tet
@@ -484,8 +458,14 @@ fn search_tet(
         // Every tet of the ring holds the edge: it is tried now.
         for &u in &s.ring.tets {
             let uv = mesh.tet(u);
-            let ia = uv.iter().position(|&x| x == s.ring.a).unwrap_or(0);
-            let ib = uv.iter().position(|&x| x == s.ring.b).unwrap_or(1);
+            let ia = uv
+                .iter()
+                .position(|&x| x == s.ring.a)
+                .expect("every tet of the ring holds the edge's end a");
+            let ib = uv
+                .iter()
+                .position(|&x| x == s.ring.b)
+                .expect("every tet of the ring holds the edge's end b");
             let k = EDGE_OF[ia][ib];
             if k < 6 {
                 tried[u as usize].fetch_or(1 << k, Ordering::Relaxed);

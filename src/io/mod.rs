@@ -6,6 +6,7 @@
 //! the file and, where there is one, the line. Writers go through
 //! [`write_atomic`], so a failed write never leaves a partial file behind.
 
+pub mod edges;
 pub mod fields;
 pub mod gid;
 pub mod gmsh;

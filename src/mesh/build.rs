@@ -278,7 +278,9 @@ impl TetMesh {
             (0..4).any(|f| adj[t][f] != NO_ADJ && ((adj[t][f] >> 2) as usize) > t && overlaps(t, f))
         });
         if let Some(t) = overlap {
-            let f = (0..4).find(|&f| overlaps(t, f)).unwrap_or(0);
+            let f = (0..4)
+                .find(|&f| overlaps(t, f))
+                .expect("find_first picked t for one of its faces");
             let l = TET_FACES[f];
             let v = tets[t];
             return Err(MeshError::Overlap {

@@ -93,7 +93,7 @@ pub struct TetMesh {
     pub(crate) required: FastHashSet<u32>,
     /// One live tet holding each vertex (`DEAD` for unused points). Every
     /// operation re-creates tets over all vertices of the cavity it removes, and
-    /// `alloc_tet`/`set_tet` write this entry, so it never goes stale.
+    /// `alloc_tet` writes this entry, so it never goes stale.
     pub(crate) v2t: Vec<u32>,
 }
 
@@ -353,12 +353,75 @@ impl TetMesh {
         &self.required
     }
 
+    // ----- the one rule for constrained faces and vertices -----------------------
+
+    /// Whether the face `face` of tet `t`, whose other side is the tet
+    /// `other` (`None` on the boundary), is *constrained*: it must survive
+    /// every operation as the boundary does. That is the case on the
+    /// boundary, between two regions, and for a marked face. Every
+    /// operation, the improvement passes and the √3 step ask this one rule.
+    #[inline]
+    pub fn face_is_constrained(&self, t: u32, other: Option<u32>, face: [u32; 3]) -> bool {
+        match other {
+            None => true,
+            Some(u) => {
+                self.region(u) != self.region(t)
+                    || (!self.face_markers.is_empty() && self.face_marker(face).is_some())
+            }
+        }
+    }
+
+    /// Whether interior face `f` of `t` is constrained ([`Self::face_is_constrained`]):
+    /// it separates two regions or carries a marker. False for boundary faces.
+    #[inline]
+    pub fn is_interface_face(&self, t: u32, f: usize) -> bool {
+        let h = self.adj(t)[f];
+        h != NO_ADJ && self.face_is_constrained(t, Some(h >> 2), self.face_vertices(t, f))
+    }
+
+    /// Per point: must it stay where it is? The vertices of constrained
+    /// faces ([`Self::face_is_constrained`]), of feature edges, corners and
+    /// required vertices.
+    pub fn fixed_vertices(&self) -> Vec<bool> {
+        let mut fixed = vec![false; self.n_points()];
+        for t in self.tet_ids() {
+            let adj = self.adj(t);
+            for (f, &h) in adj.iter().enumerate() {
+                let fv = self.face_vertices(t, f);
+                if self.face_is_constrained(t, (h != NO_ADJ).then_some(h >> 2), fv) {
+                    for v in fv {
+                        fixed[v as usize] = true;
+                    }
+                }
+            }
+        }
+        for e in self.feature_edges().keys() {
+            fixed[e[0] as usize] = true;
+            fixed[e[1] as usize] = true;
+        }
+        for &v in self.corners().iter().chain(self.required_vertices()) {
+            fixed[v as usize] = true;
+        }
+        fixed
+    }
+
     // ----- topology edits ------------------------------------------------------
 
     /// Links half-face `a = 4*t+i` with half-face `b = 4*t'+j` (both sides), or
     /// marks `a` as boundary when `b` is [`NO_ADJ`].
+    ///
+    /// Crate-private, as are `alloc_tet` and `kill_tet`: a
+    /// sequence such as `bond(a, b); bond(c, b)` leaves `a` pointing at a
+    /// face that points elsewhere, and the bulk flip's `unsafe` relies on
+    /// adjacency being mutual. Users change the mesh through the checked
+    /// operations only:
+    ///
+    /// ```compile_fail
+    /// let mut mesh = tetrefine::TetMesh::default();
+    /// mesh.bond(0, 5); // error[E0624]: method `bond` is private
+    /// ```
     #[inline]
-    pub fn bond(&mut self, a: u32, b: u32) {
+    pub(crate) fn bond(&mut self, a: u32, b: u32) {
         debug_assert!(a != NO_ADJ);
         self.adj[(a >> 2) as usize][(a & 3) as usize] = b;
         if b != NO_ADJ {
@@ -368,7 +431,7 @@ impl TetMesh {
 
     /// Creates a tet (reusing a free slot if there is one) with no adjacency yet.
     /// The caller must bond all four faces.
-    pub fn alloc_tet(&mut self, v: [u32; 4], region: i32) -> u32 {
+    pub(crate) fn alloc_tet(&mut self, v: [u32; 4], region: i32) -> u32 {
         debug_assert!(v.iter().all(|&x| (x as usize) < self.points.len()));
         let t = self.alloc_slot(v, region);
         for x in v {
@@ -399,18 +462,8 @@ impl TetMesh {
         }
     }
 
-    /// Replaces the vertices of a live tet in place (adjacency untouched).
-    #[inline]
-    pub fn set_tet(&mut self, t: u32, v: [u32; 4]) {
-        debug_assert!(self.is_alive(t));
-        self.tets[t as usize] = v;
-        for x in v {
-            self.v2t[x as usize] = t;
-        }
-    }
-
     /// Frees tet `t`; its neighbours still point to it until re-bonded.
-    pub fn kill_tet(&mut self, t: u32) {
+    pub(crate) fn kill_tet(&mut self, t: u32) {
         let i = t as usize;
         debug_assert!(self.tets[i][0] != DEAD, "tet {t} killed twice");
         self.tets[i] = [DEAD; 4];

@@ -28,7 +28,6 @@
 //! The result equals calling [`super::flip23`] on the faces in order (same
 //! slots, generations and vertex → tet entries). Seed paper §3.1 (Figure 5).
 
-use super::is_constrained_face;
 use crate::geom::all_positive;
 use crate::mesh::{TetMesh, DEAD, NO_ADJ};
 use crate::topo::scatter::{Disjoint, LastTouch};
@@ -60,7 +59,9 @@ impl Flip {
         let mut code = f as u8;
         for (s, &i) in l.iter().enumerate() {
             let x = vt[i];
-            let j = (0..4).find(|&j| vu[j] == x).unwrap_or(0);
+            let j = (0..4)
+                .find(|&j| vu[j] == x)
+                .expect("the two tets of a flip share face f, so u holds every vertex of it");
             code |= (j as u8) << (2 + 2 * s);
         }
         Flip {
@@ -137,7 +138,7 @@ impl FlipBatch {
     /// (it has exactly one vertex at or above `first_barycentre`, the
     /// barycentre) the old face opposite that vertex when the tet across it
     /// is a child too and the face is not constrained
-    /// ([`is_constrained_face`]). Each face once, as `(t, f)` with `t` the
+    /// ([`TetMesh::is_interface_face`]). Each face once, as `(t, f)` with `t` the
     /// lower slot, in ascending `t`; each flip is marked valid when its three
     /// new tets are positive (exact predicate, as [`super::flip23_valid`]).
     ///
@@ -164,7 +165,7 @@ impl FlipBatch {
                 return None;
             }
             let (u, g) = TetMesh::half_face(h);
-            if u < t || tets[u as usize][g] < first || is_constrained_face(mesh, t, i) {
+            if u < t || tets[u as usize][g] < first || mesh.is_interface_face(t, i) {
                 return None;
             }
             Some((i, u))

@@ -20,9 +20,10 @@
 //! paper §4: the new boundary edge joins the two face barycentres p0 and p_m.
 
 use super::{replace_cavity, OpError};
-use crate::geom::{orient3d, tet_min_sine};
+use crate::geom::{all_positive, tet_min_sine};
 use crate::mesh::{TetMesh, NO_ADJ};
 use crate::topo::{TET_EDGES, TET_EDGE_OPPOSITE};
+use glam::DVec3;
 
 /// The tets around an edge `(a, b)` in rotational order.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
@@ -152,42 +153,81 @@ pub struct RingTriangulation {
     pub triangles: Vec<[usize; 3]>,
 }
 
+/// Reusable buffers of [`best_ring_triangulation_above`].
+#[derive(Default)]
+pub struct RingScratch {
+    p: Vec<DVec3>,
+    best: Vec<f64>,
+    arg: Vec<usize>,
+    stack: Vec<(usize, usize)>,
+}
+
 /// Shewchuk's dynamic programme over the ring polygon: the triangulation whose
 /// worst tet (coned to `a` and to `b`) is best. Triangles producing a flat or
-/// inverted tet (exact predicate) are excluded.
+/// inverted tet (exact predicate) are excluded. Its quality is −∞ (and it has
+/// no triangles) when no triangulation is valid.
 pub fn best_ring_triangulation(mesh: &TetMesh, ring: &EdgeRing) -> RingTriangulation {
+    best_ring_triangulation_above(mesh, ring, f64::NEG_INFINITY, &mut RingScratch::default())
+}
+
+/// The programme of [`best_ring_triangulation`] with a bar: a triangle whose
+/// worst tet does not beat `bar` counts as invalid. Since
+/// `x ↦ (x > bar ? x : −∞)` commutes with `min` and `max`, every sub-polygon
+/// value above the bar, and every choice made among such values, is the one
+/// of the plain programme: when a triangulation beats the bar it is the same
+/// triangulation (with `bar = −∞` this *is* the plain programme). But
+/// sub-polygons that cannot beat the bar are settled after one tet quality,
+/// and the exact orientation predicate (slow on the nearly coplanar ring
+/// vertices of structured meshes) only runs on triangles that already beat
+/// the bar. Returns quality −∞ and no triangles when nothing beats the bar.
+pub fn best_ring_triangulation_above(
+    mesh: &TetMesh,
+    ring: &EdgeRing,
+    bar: f64,
+    s: &mut RingScratch,
+) -> RingTriangulation {
+    let none = RingTriangulation {
+        quality: f64::NEG_INFINITY,
+        triangles: Vec::new(),
+    };
     let r = ring.verts.len();
     if r < 3 {
-        return RingTriangulation {
-            quality: f64::NEG_INFINITY,
-            triangles: Vec::new(),
-        };
+        return none;
     }
     let pa = mesh.point(ring.a);
     let pb = mesh.point(ring.b);
-    let p: Vec<_> = ring.verts.iter().map(|&v| mesh.point(v)).collect();
-    // q(i,k,j) of one triangle: both tets positive, then their worst quality.
+    s.p.clear();
+    s.p.extend(ring.verts.iter().map(|&v| mesh.point(v)));
+    let p = &s.p;
+    if ring.closed && ring_bound_fails(pa, pb, p, bar) {
+        return none;
+    }
+    // Worst quality of the two tets of triangle (i, k, j) if it beats the
+    // bar and both are positive, else −∞.
     let tri_q = |i: usize, k: usize, j: usize| -> f64 {
         let ta = [pa, p[i], p[k], p[j]];
-        let tb = [pb, p[j], p[k], p[i]];
-        if orient3d(ta[0], ta[1], ta[2], ta[3]) <= 0.0
-            || orient3d(tb[0], tb[1], tb[2], tb[3]) <= 0.0
-        {
+        let qa = tet_min_sine(&ta);
+        if qa.is_nan() || qa <= bar {
             return f64::NEG_INFINITY;
         }
-        tet_min_sine(&ta).min(tet_min_sine(&tb))
+        let tb = [pb, p[j], p[k], p[i]];
+        let q = qa.min(tet_min_sine(&tb));
+        if q.is_nan() || q <= bar || !all_positive([ta, tb]) {
+            return f64::NEG_INFINITY;
+        }
+        q
     };
-    let mut best = vec![f64::INFINITY; r * r];
-    let mut arg = vec![usize::MAX; r * r];
+    s.best.clear();
+    s.best.resize(r * r, f64::INFINITY);
+    s.arg.clear();
+    s.arg.resize(r * r, usize::MAX);
     for len in 2..r {
         for i in 0..r - len {
             let j = i + len;
             let mut b = f64::NEG_INFINITY;
             let mut bk = usize::MAX;
             for k in i + 1..j {
-                let left = best[i * r + k];
-                let right = best[k * r + j];
-                let cand = left.min(right);
+                let cand = s.best[i * r + k].min(s.best[k * r + j]);
                 if cand <= b {
                     continue;
                 }
@@ -197,25 +237,57 @@ pub fn best_ring_triangulation(mesh: &TetMesh, ring: &EdgeRing) -> RingTriangula
                     bk = k;
                 }
             }
-            best[i * r + j] = b;
-            arg[i * r + j] = bk;
+            s.best[i * r + j] = b;
+            s.arg[i * r + j] = bk;
         }
     }
-    let quality = best[r - 1];
+    let quality = s.best[r - 1];
+    if quality <= bar {
+        return none;
+    }
     let mut triangles = Vec::with_capacity(r - 2);
-    if quality > f64::NEG_INFINITY {
-        let mut stack = vec![(0usize, r - 1)];
-        while let Some((i, j)) = stack.pop() {
-            if j < i + 2 {
-                continue;
-            }
-            let k = arg[i * r + j];
-            triangles.push([i, k, j]);
-            stack.push((i, k));
-            stack.push((k, j));
+    s.stack.clear();
+    s.stack.push((0, r - 1));
+    while let Some((i, j)) = s.stack.pop() {
+        if j < i + 2 {
+            continue;
         }
+        let k = s.arg[i * r + j];
+        triangles.push([i, k, j]);
+        s.stack.push((i, k));
+        s.stack.push((k, j));
     }
     RingTriangulation { quality, triangles }
+}
+
+/// Whether a quick upper bound already rules out beating `beat` on a closed
+/// ring with edge ends `pa`, `pb` and ring points `p`.
+///
+/// Each side `(p_i, p_i+1)` of the ring polygon lies in one triangle
+/// `(p_i, p_i+1, p_k)` of any triangulation, and its two new tets (coned to
+/// `a` and to `b`) split the dihedral angle θ of the old tet
+/// `(a, b, p_i, p_i+1)` at that side between them (both positive means the
+/// triangle's half-plane lies inside the old wedge). One of the two has an
+/// angle of at most θ/2 < 90°, so no triangulation beats `sin(θ/2)`. The test
+/// `sin²(θ/2) = (1 − cos θ)/2 ≤ beat²` keeps a margin, so that it only rules
+/// out what the full programme would reject too.
+fn ring_bound_fails(pa: DVec3, pb: DVec3, p: &[DVec3], beat: f64) -> bool {
+    if beat <= 0.0 {
+        return false;
+    }
+    let r = p.len();
+    let limit = 2.0 * beat * beat - 1e-9;
+    for i in 0..r {
+        let (p0, p1) = (p[i], p[(i + 1) % r]);
+        let u = p1 - p0;
+        let na = u.cross(pa - p0);
+        let nb = u.cross(pb - p0);
+        let d = (na.length_squared() * nb.length_squared()).sqrt();
+        if d > 0.0 && 1.0 - na.dot(nb) / d <= limit {
+            return true;
+        }
+    }
+    false
 }
 
 /// Removes the edge of `ring` if the best triangulation's worst tet has

@@ -2,7 +2,7 @@
 //! parallel rounds that give the result of the one-by-one repair.
 //!
 //! Where the segment between the two barycentres `p`, `q` of a flip misses
-//! their shared face (the input violates the precondition the seed paper
+//! their shared face (the input violates the precondition the √3 paper (Burkhart, Hamann and Umlauf)
 //! borrows from Lehner), both are pulled towards the face's centroid by a
 //! factor 0.7, 0.5, 0.3, 0.15 or 0.05 — the first that keeps every child of
 //! `p` and `q` positive, makes the flip valid and leaves every other flip of
@@ -151,7 +151,10 @@ pub fn make_flips_valid(mesh: &mut TetMesh, batch: &mut FlipBatch) -> usize {
     keys.dedup();
     repairs.par_iter_mut().for_each(|r| {
         for x in r.reach.iter_mut() {
-            *x = keys.binary_search(x).unwrap_or(0) as u32;
+            *x = keys
+                .binary_search(x)
+                .expect("keys holds every reached point: it was collected from them")
+                as u32;
         }
     });
     let owner: Vec<AtomicU32> = (0..keys.len()).map(|_| AtomicU32::new(u32::MAX)).collect();

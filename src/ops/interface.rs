@@ -124,7 +124,7 @@ pub fn remove_interface_edge(
             .tets
             .iter()
             .position(|&t| t == side.tets[0])
-            .unwrap_or(0);
+            .expect("the side's first tet is a tet of the edge's ring");
         for &[i, k, j] in &tri.triangles {
             new.push([ring.a, side.verts[i], side.verts[k], side.verts[j]]);
             new.push([ring.b, side.verts[j], side.verts[k], side.verts[i]]);

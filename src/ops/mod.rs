@@ -1,6 +1,6 @@
 //! Local operations on the tet mesh, one family per file.
 //!
-//! Every operation has the same shape (DESIGN §3): gather the cavity (the tets
+//! Every operation has the same shape: gather the cavity (the tets
 //! it removes), build the new tets, check each with the exact `orient3d`,
 //! and only then replace the cavity — re-using the freed slots and re-linking
 //! the outer faces with `bond`. An operation that would create an inverted or
@@ -52,16 +52,6 @@ pub fn all_positive(mesh: &TetMesh, tets: &[[u32; 4]]) -> bool {
     crate::geom::all_positive(tets.iter().map(|v| v.map(|x| mesh.point(x))))
 }
 
-/// Whether interior face `f` of `t` must survive like the boundary: it
-/// separates two regions or carries a marker. (False for boundary faces.)
-pub fn is_constrained_face(mesh: &TetMesh, t: u32, f: usize) -> bool {
-    let h = mesh.adj(t)[f];
-    h != NO_ADJ
-        && (mesh.region(h >> 2) != mesh.region(t)
-            || (!mesh.face_markers().is_empty()
-                && mesh.face_marker(mesh.face_vertices(t, f)).is_some()))
-}
-
 /// Replaces the tets `old` by the tets `new`, re-using slots and re-linking
 /// adjacency. The new tets must fill the cavity: each of their faces is either
 /// shared by two new tets, equal to an outer face of the cavity, or a new
@@ -98,7 +88,7 @@ pub fn replace_cavity(
     }
     let oldest = (0..old.len())
         .max_by_key(|&i| (mesh.level(old[i]), std::cmp::Reverse(i)))
-        .unwrap_or(0);
+        .expect("a cavity holds at least one tet (old[0] was read above)");
     let origin = vec![oldest; new.len()];
     replace_cavity_raw(mesh, old, new, &origin)
 }
@@ -107,7 +97,7 @@ pub fn replace_cavity(
 /// interior markers themselves (trisection, interface splits and flips):
 /// new tet `i` takes region, level and parent of `old[origin[i]]`; marked
 /// faces inside the cavity are not checked (the caller moves their markers).
-pub fn replace_cavity_raw(
+pub(crate) fn replace_cavity_raw(
     mesh: &mut TetMesh,
     old: &[u32],
     new: &[[u32; 4]],

@@ -1,15 +1,16 @@
 //! Boundary 1-3 split: a new vertex on a boundary face splits its tet in three.
 //!
 //! ```text
-//!              c                  boundary face (a,b,c) of tet (a,b,c,d),
-//!             /|\                 apex d inside; m on the face:
-//!            / | \                  (a,b,m,d) (b,c,m,d) (c,a,m,d)
-//!           /  m  \               the three new boundary faces (a,b,m),
-//!          / /   \ \              (b,c,m), (c,a,m) keep the face's marker.
-//!         a---------b
+//!              c                  boundary face f = (a,b,c) of tet t, as
+//!             /|\                 TET_FACES[f] lists it (outward), d the
+//!            / | \                vertex opposite it; m on the face. The new
+//!           /  m  \               tets, positive: (b,a,m,d) (c,b,m,d)
+//!          / /   \ \              (a,c,m,d); their boundary faces (a,b,m),
+//!         a---------b             (b,c,m), (c,a,m) keep the face's marker.
 //! ```
 //!
-//! Seed paper §4 ("tetrahedral 1-3 split", its Figure 7b): the boundary half of
+//! Burkhart, Hamann and Umlauf, "Adaptive and feature-preserving subdivision
+//! for high-quality tetrahedral meshes", §4 ("tetrahedral 1-3 split", its Figure 7b): the boundary half of
 //! Kobbelt's √3 1-3 split.
 
 use super::{replace_cavity, OpError};

@@ -1,5 +1,5 @@
 //! Edge trisection: two new vertices on an edge split every tet around it in
-//! three (seed paper §5, its Figure 7a — the crease rule of even steps).
+//! three (the √3 paper, §5, its Figure 7a — the crease rule of even steps).
 //!
 //! ```text
 //!        a ---- x1 ---- x2 ---- b        each ring tet (a,b,p,q) becomes

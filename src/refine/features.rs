@@ -18,6 +18,7 @@
 //! at least one), plus those tagged in the input. Tags read from the input
 //! (Medit `Edges`/`Ridges`, `Corners`, `RequiredVertices`) are kept.
 
+use crate::file::IoError;
 use crate::mesh::{edge_key, TetMesh, NO_ADJ};
 use glam::DVec3;
 use std::collections::HashMap;
@@ -163,30 +164,14 @@ pub fn tag_corners(mesh: &mut TetMesh) {
     }
 }
 
-/// Reads a plain edge list (`v0 v1` per line, 0-based; `#` comments) and tags
-/// those edges; an edge that is not an edge of the mesh is an error.
-pub fn read_edge_list(mesh: &mut TetMesh, path: &Path) -> Result<usize, crate::io::IoError> {
-    use crate::io::{IoError, Tokens};
-    let bytes = std::fs::read(path).map_err(|e| IoError::file(path, e.to_string()))?;
-    let text = std::str::from_utf8(&bytes).map_err(|_| IoError::file(path, "not a text file"))?;
-    let mut tok = Tokens::new(path, text, true);
-    let n = mesh.n_points();
-    let mut edges = Vec::new();
-    while tok.peek().is_some() {
-        let a: i64 = tok.parse("a vertex index")?;
-        let line = tok.line();
-        let b: i64 = tok.parse("a second vertex index")?;
-        for x in [a, b] {
-            if x < 0 || x as usize >= n {
-                return Err(IoError::at(
-                    path,
-                    line,
-                    format!("vertex {x} is out of range 0..{n} (0-based)"),
-                ));
-            }
-        }
-        edges.push(([a as u32, b as u32], line));
-    }
+/// Tags the edges of an edge list read from `path` (each with its line) as
+/// feature edges and re-derives the corners; an edge that is not an edge of
+/// the mesh is an error at its line, and then nothing is tagged.
+pub fn tag_edge_list(
+    mesh: &mut TetMesh,
+    path: &Path,
+    edges: &[([u32; 2], usize)],
+) -> Result<usize, IoError> {
     let mut all: std::collections::HashSet<[u32; 2]> = std::collections::HashSet::new();
     for t in mesh.tet_ids() {
         let v = mesh.tet(t);
@@ -194,14 +179,17 @@ pub fn read_edge_list(mesh: &mut TetMesh, path: &Path) -> Result<usize, crate::i
             all.insert(edge_key(v[i], v[j]));
         }
     }
-    for ([a, b], line) in &edges {
-        if !all.contains(&edge_key(*a, *b)) {
-            return Err(IoError::at(
-                path,
-                *line,
-                format!("({a}, {b}) is not an edge of the mesh"),
-            ));
-        }
+    if let Some(([a, b], line)) = edges
+        .iter()
+        .find(|([a, b], _)| !all.contains(&edge_key(*a, *b)))
+    {
+        return Err(IoError::at(
+            path,
+            *line,
+            format!("({a}, {b}) is not an edge of the mesh"),
+        ));
+    }
+    for ([a, b], _) in edges {
         mesh.set_feature_edge(*a, *b, Some(0));
     }
     tag_corners(mesh);

@@ -457,3 +457,35 @@ pub fn select(
     }
     Ok(slots)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::generate::cube_grid;
+
+    fn chosen(sel: &[bool]) -> Vec<usize> {
+        sel.iter()
+            .enumerate()
+            .filter(|(_, &s)| s)
+            .map(|(i, _)| i)
+            .collect()
+    }
+
+    /// Here rather than in the integration tests: a dead slot is made with
+    /// the crate-private `kill_tet`.
+    #[test]
+    fn selection_is_indexed_by_slot_with_values_in_live_order() {
+        let (mut mesh, _) = TetMesh::from_data(&cube_grid(1)).unwrap();
+        // Kill slot 2: five live tets 0, 1, 3, 4, 5 take the five values in order.
+        mesh.kill_tet(2);
+        assert_eq!(mesh.n_tets(), 5);
+        assert_eq!(mesh.n_tet_slots(), 6);
+        let v = [0.0, 1.0, 5.0, 2.0, 3.0]; // tets 0, 1, 3, 4, 5
+        let parse = |s: &str| s.parse::<MarkStrategy>().unwrap();
+        let sel = select(&parse("fraction:0.4"), Some(&v), &mesh).unwrap();
+        assert_eq!(sel.len(), 6);
+        assert_eq!(chosen(&sel), vec![3, 5]);
+        let all = select(&parse("max:0"), Some(&v), &mesh).unwrap();
+        assert_eq!(chosen(&all), vec![0, 1, 3, 4, 5]);
+    }
+}

@@ -6,8 +6,8 @@ use crate::mesh::ball_stays_positive;
 use crate::mesh::fasthash::FastHashMap;
 use crate::mesh::{edge_key, TetMarks, TetMesh};
 use crate::ops::{
-    flip23_bulk, is_constrained_face, make_flips_valid, remove_edge, remove_interface_edge,
-    split14_bulk, split_boundary_face, split_interface_face, trisect_edge, EdgeRing, FlipBatch,
+    flip23_bulk, make_flips_valid, remove_edge, remove_interface_edge, split14_bulk,
+    split_boundary_face, split_interface_face, trisect_edge, EdgeRing, FlipBatch,
 };
 use crate::stencil::sqrt3_positions_trisecting;
 use crate::topo::TET_EDGES;
@@ -17,20 +17,34 @@ use std::time::Instant;
 
 /// Runs `steps` refinement steps; one report per step.
 ///
-/// With a selection (adaptive refinement, seed paper §6), step 1 splits the
-/// selected tets and every later step splits their descendants again — the
-/// tets whose `level` the previous step raised — so the selected zone is
+/// With a selection (adaptive refinement, the √3 paper's §6), step 1 splits
+/// the selected tets and every later step splits their descendants again —
+/// the tets whose `level` the previous step raised — so the selected zone is
 /// refined `steps` times (the paper's Figure 13).
 pub fn refine(mesh: &mut TetMesh, steps: usize, opts: &RefineOptions) -> Vec<StepReport> {
     let mut reports = Vec::with_capacity(steps);
+    refine_with(mesh, steps, opts, &NoProgress, |_, _, r| reports.push(r));
+    reports
+}
+
+/// [`refine`] with progress callbacks and a callback after every step:
+/// `on_step(step, mesh, report)` sees the mesh as the 1-based `step` left it
+/// (statistics, intermediate files) before the next step begins.
+pub fn refine_with(
+    mesh: &mut TetMesh,
+    steps: usize,
+    opts: &RefineOptions,
+    progress: &dyn Progress,
+    mut on_step: impl FnMut(usize, &TetMesh, StepReport),
+) {
     let mut step_opts = opts.clone();
     for s in 1..=steps {
         if s > 1 && opts.selection.is_some() {
             step_opts.selection = Some(descendants_of_last_step(mesh, s - 1));
         }
-        reports.push(refine_step(mesh, s, &step_opts));
+        let report = refine_step_with_progress(mesh, s, &step_opts, progress);
+        on_step(s, mesh, report);
     }
-    reports
 }
 
 /// Per tet slot: was it refined in step `step` (its level is `step`)? With a
@@ -188,7 +202,7 @@ fn boundary_split_phase(mesh: &mut TetMesh, st: &mut StepState, report: &mut Ste
             }
             if mesh.is_boundary_face(t, f) {
                 faces.push((t, f));
-            } else if is_constrained_face(mesh, t, f) {
+            } else if mesh.is_interface_face(t, f) {
                 let (u, g) = TetMesh::half_face(mesh.adj(t)[f]);
                 let w = mesh.tet(u);
                 if u > t && w[g] >= first && (0..4).all(|j| j == g || w[j] < first) {
@@ -253,9 +267,7 @@ fn constrained_ring_vertices(mesh: &TetMesh, ring: &EdgeRing) -> Vec<u32> {
         // Face (a, b, verts[i]) lies between tets i-1 and i.
         let (t0, t1) = (ring.tets[(i + n - 1) % n], ring.tets[i]);
         let p = ring.verts[i];
-        let marked =
-            !mesh.face_markers().is_empty() && mesh.face_marker([ring.a, ring.b, p]).is_some();
-        if mesh.region(t0) != mesh.region(t1) || marked {
+        if mesh.face_is_constrained(t0, Some(t1), [ring.a, ring.b, p]) {
             out.push(p);
         }
     }
@@ -275,7 +287,7 @@ fn flat_enough(mesh: &TetMesh, a: u32, b: u32, m1: u32, m2: u32) -> bool {
 /// all split is flipped (boundary: edge removal, m → 2m − 2; interface: the
 /// two-sided removal of [`remove_interface_edge`]), so that the new edge joins
 /// two face points. Feature edges are kept in odd steps and trisected in even
-/// steps (seed paper §5).
+/// steps (the √3 paper, §5).
 fn boundary_flip_phase(mesh: &mut TetMesh, st: &mut StepState, report: &mut StepReport) {
     let fp = st.first_face_point;
     // Old edges seen from the split faces, with how often and one face point.

@@ -1,12 +1,12 @@
 //! The histogram of the per-tet minimum dihedral angle (the fourth row of
-//! Figure 12 of the seed paper) as CSV, SVG or PNG.
+//! Figure 12 of the √3 paper (Burkhart, Hamann and Umlauf)) as CSV, SVG or PNG.
 //!
 //! The plots are drawn with plotters. Text is rasterised by `ab_glyph` from
 //! the DejaVu Sans font embedded in the binary (`assets/DejaVuSans.ttf`), so
 //! nothing depends on the fonts of the machine.
 
 use super::Histogram;
-use crate::io::{write_atomic, IoError};
+use crate::file::{write_atomic, IoError};
 use plotters::prelude::*;
 use std::io::Write;
 use std::path::Path;

@@ -1,4 +1,4 @@
-//! Mesh statistics: the rows of Table 1 of the seed paper plus boundary and
+//! Mesh statistics: the rows of Table 1 of the √3 paper (Burkhart, Hamann and Umlauf) plus boundary and
 //! interior faces, maximum dihedral angle, inverted count, volume, regions and
 //! the minimum-dihedral histogram, in one parallel sweep over the tets.
 //!

@@ -1,4 +1,4 @@
-//! The statistics as a plain-text table: the rows of Table 1 of the seed paper
+//! The statistics as a plain-text table: the rows of Table 1 of the √3 paper (Burkhart, Hamann and Umlauf)
 //! (Burkhart, Hamann and Umlauf, "Adaptive and feature-preserving subdivision
 //! for high-quality tetrahedral meshes": nodes, edges, tets, worst / average /
 //! best minimum dihedral angle, average / maximal valence) plus boundary and

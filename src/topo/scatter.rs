@@ -34,6 +34,8 @@ pub(crate) struct Disjoint<'a, T> {
 // methods whose contract is that no two tasks access one element (or, for
 // `write_lane`, one lane) where one of them writes.
 unsafe impl<T: Send> Send for Disjoint<'_, T> {}
+// SAFETY: as for `Send`: shared use from several tasks only reaches the
+// elements through those `unsafe` methods and their disjointness contract.
 unsafe impl<T: Send> Sync for Disjoint<'_, T> {}
 
 impl<'a, T: Copy> Disjoint<'a, T> {

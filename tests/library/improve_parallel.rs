@@ -7,7 +7,7 @@ use std::collections::HashSet;
 
 use tetrefine::geom::{orient3d, tet_min_sine};
 use tetrefine::improve::colour::{colour_balls_except, colour_classes, sequential_levels, Balls};
-use tetrefine::improve::{fixed_vertices, improve, ImproveOptions};
+use tetrefine::improve::{improve, ImproveOptions};
 use tetrefine::io::load_mesh;
 use tetrefine::mesh::ball_stays_positive;
 use tetrefine::mesh::generate::cube_grid;
@@ -32,7 +32,7 @@ fn all_positive(mesh: &TetMesh) -> bool {
 fn perturbed_cube() -> TetMesh {
     let n = 8;
     let (mut mesh, _) = TetMesh::from_data(&cube_grid(n)).unwrap();
-    let fixed = fixed_vertices(&mesh);
+    let fixed = mesh.fixed_vertices();
     let h = 1.0 / n as f64;
     let mut state = 0x2545_f491_4f6c_dd1du64;
     let mut next = || {
@@ -180,7 +180,7 @@ fn improve_in_small_blocks_is_thread_independent_and_never_inverts() {
 #[test]
 fn colour_classes_of_the_tripod_are_independent_sets() {
     let (mesh, _) = load_mesh(&crate::support::path("meshes/tripod.mesh")).unwrap();
-    let fixed = fixed_vertices(&mesh);
+    let fixed = mesh.fixed_vertices();
     let verts: Vec<u32> = (0..mesh.n_points() as u32)
         .filter(|&v| !fixed[v as usize] && mesh.tet_of_vertex(v).is_some())
         .collect();
@@ -208,7 +208,7 @@ fn colour_classes_of_the_tripod_are_independent_sets() {
 #[test]
 fn vertices_set_apart_get_classes_of_their_own_before_and_after() {
     let (mesh, _) = load_mesh(&crate::support::path("meshes/tripod.mesh")).unwrap();
-    let fixed = fixed_vertices(&mesh);
+    let fixed = mesh.fixed_vertices();
     let verts: Vec<u32> = (0..mesh.n_points() as u32)
         .filter(|&v| !fixed[v as usize] && mesh.tet_of_vertex(v).is_some())
         .collect();

@@ -10,7 +10,7 @@
 //!   [`catmull_clark`], [`doo_sabin`], [`catmull_clark_weighted`]
 //!   (Hansmeyer's weighted and extruded Catmull–Clark), all with tagged
 //!   creases and corners through [`features`];
-//! * the seed papers' other constructions: [`mod@sierpinski`] (Sierpinski
+//! * the other constructions of the √3 paper's companions: [`mod@sierpinski`] (Sierpinski
 //!   polyhedra), [`mod@truncate`] (Chaikin vertex truncation) and [`ifs`]
 //!   (subdivision as iterated function systems).
 

@@ -1,4 +1,4 @@
-//! Sierpinski polyhedra by subdivision (seed paper `000`: Akleman, Srinivasan,
+//! Sierpinski polyhedra by subdivision (Akleman, Srinivasan,
 //! Chen et al., "Generalized Sierpinski polyhedra", a subdivision-inspired
 //! construction on top of Topological Mesh Modeling).
 //!
@@ -96,7 +96,7 @@ impl SierpinskiOptions {
     }
 }
 
-/// `steps` Sierpinski steps (seed paper `000`) on a closed, consistently
+/// `steps` Sierpinski steps (Akleman et al.'s construction) on a closed, consistently
 /// oriented manifold polygon mesh, with the default [`SierpinskiOptions`].
 ///
 /// Returns one closed oriented manifold per connected component of the

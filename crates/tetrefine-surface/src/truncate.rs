@@ -1,4 +1,4 @@
-//! Chaikin vertex truncation (seed paper `004`: Akleman, Edmundson and Ozener,
+//! Chaikin vertex truncation (Akleman, Edmundson and Ozener,
 //! "A generalized vertex truncation scheme to construct intriguing polyhedral
 //! shapes").
 //!

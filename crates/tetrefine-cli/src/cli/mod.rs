@@ -8,6 +8,7 @@ pub mod mesh;
 pub mod progress;
 pub mod quality;
 pub mod refine;
+pub mod steps;
 pub mod surface;
 
 use std::path::Path;
@@ -120,7 +121,8 @@ pub fn write_refined(
 /// Applies `--features auto|none|FILE` to a freshly loaded mesh and tells the
 /// user on stderr what it found.
 pub fn apply_feature_option(mesh: &mut TetMesh, spec: &str, angle_deg: f64) -> CliResult {
-    use tetrefine::refine::features::{detect_features, read_edge_list};
+    use tetrefine::io::edges::read_edge_list;
+    use tetrefine::refine::features::detect_features;
     match spec {
         "none" => mesh.clear_features(),
         "auto" => {
@@ -144,11 +146,5 @@ pub fn apply_feature_option(mesh: &mut TetMesh, spec: &str, angle_deg: f64) -> C
 
 /// Writes the feature edges of `mesh` as two-point polylines (.vtp or .csv).
 pub fn write_feature_lines(path: &Path, mesh: &TetMesh) -> CliResult {
-    let mut edges: Vec<[u32; 2]> = mesh.feature_edges().keys().copied().collect();
-    edges.sort_unstable();
-    let lines: Vec<Vec<glam::DVec3>> = edges
-        .iter()
-        .map(|e| vec![mesh.point(e[0]), mesh.point(e[1])])
-        .collect();
-    tetrefine_surface::ifs::write_polylines(path, &lines).map_err(|e| e.to_string())
+    tetrefine::polyline::write_feature_lines(path, mesh).map_err(|e| e.to_string())
 }

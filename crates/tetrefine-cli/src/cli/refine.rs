@@ -2,15 +2,13 @@
 //! [--stop-after PHASE] [--stats FILE.json] [--histogram FILE]`.
 
 use super::progress::BarProgress;
+use super::steps::StepStats;
 use std::path::PathBuf;
 use std::time::Instant;
 use tetrefine::io::indicator::read_indicator;
 use tetrefine::refine::marking::{select, MarkStrategy};
-use tetrefine::refine::step::descendants_of_last_step;
-use tetrefine::refine::{
-    locate_parents, refine_step_with_progress, Phase, RefineOptions, Sqrt3Rule,
-};
-use tetrefine::report::steps::{step_row, step_table_header, StepStats};
+use tetrefine::refine::{locate_parents, refine_with, Phase, RefineOptions, Sqrt3Rule};
+use tetrefine::report::steps::{step_row, step_table_header};
 use tetrefine::MeshStats;
 
 /// The `--stats` file: `{"steps": [input, step 1, …]}`.
@@ -160,7 +158,7 @@ pub fn run(a: Args) -> super::CliResult {
         ));
     }
     if let Some(f) = &a.features_out {
-        tetrefine_surface::ifs::PolylineFormat::of(f).map_err(|e| e.to_string())?;
+        tetrefine::polyline::PolylineFormat::of(f).map_err(|e| e.to_string())?;
     }
     let strategy = mark_strategy(&a)?;
     let (mut input, meta) = super::load_with_meta(&a.input)?;
@@ -183,7 +181,7 @@ pub fn run(a: Args) -> super::CliResult {
     };
     super::apply_feature_option(&mut input, &a.features, a.feature_angle)?;
     let mut mesh = input.clone();
-    let mut opts = RefineOptions {
+    let opts = RefineOptions {
         boundary: a.boundary,
         opt_passes: a.opt_passes,
         threshold: a.threshold,
@@ -206,12 +204,8 @@ pub fn run(a: Args) -> super::CliResult {
         None => Phase::ALL.len(),
     };
     let progress = BarProgress::new(a.steps, phases_per_step);
-    for s in 1..=a.steps {
-        if s > 1 && opts.selection.is_some() {
-            opts.selection = Some(descendants_of_last_step(&mesh, s - 1));
-        }
-        let report = refine_step_with_progress(&mut mesh, s, &opts, &progress);
-        let stats = MeshStats::compute(&mesh);
+    refine_with(&mut mesh, a.steps, &opts, &progress, |s, mesh, report| {
+        let stats = MeshStats::compute(mesh);
         progress.suspend(|| {
             crate::say!("{}", step_row(&format!("step {s}"), &stats, report.seconds));
             if report.refused_flips + report.refused_boundary_flips + report.skipped_moves > 0 {
@@ -222,7 +216,7 @@ pub fn run(a: Args) -> super::CliResult {
             }
         });
         steps.push(StepStats::step(stats, &report));
-    }
+    });
     progress.finish();
     locate_parents(&input, &mut mesh);
     if let Some(path) = &a.stats {

@@ -1,4 +1,4 @@
-//! Adaptive refinement from the command line (seed paper §6): indicator
+//! Adaptive refinement from the command line (the √3 paper, §6): indicator
 //! files, marking, `--steps`, `--smooth refined`, `level`/`parent`/`marked`.
 
 use glam::DVec3;

@@ -1,6 +1,6 @@
 //! `tetrefine quality` from the outside: the JSON contract of issue 2, the
 //! histogram files, the table and option errors. Figures for the tripod are
-//! the independent reference of DESIGN §4.
+//! the independent reference figures of the tripod (967 nodes, 7.56° worst).
 
 use serde::de::{DeserializeSeed, Deserializer, IgnoredAny, MapAccess, Visitor};
 use std::fmt;
