@@ -1,6 +1,7 @@
-//! Gmsh `.msh`: MSH 2.2 (ASCII and binary) and MSH 4.1 (ASCII and binary) read,
-//! MSH 4.1 ASCII written. The layouts follow the "MSH file format" chapter of
-//! the Gmsh reference manual (C. Geuzaine, J.-F. Remacle, gmsh.info).
+//! Gmsh `.msh`: MSH 2.2 (ASCII and binary) and MSH 4.1 (ASCII and binary)
+//! read; MSH 2.2 ASCII, 4.1 ASCII and 4.1 binary written ([`MshFormat`]).
+//! The layouts follow the "MSH file format" chapter of the Gmsh reference
+//! manual (C. Geuzaine, J.-F. Remacle, gmsh.info).
 //!
 //! Tags: a tetrahedron's physical tag is its region, a triangle's its face
 //! marker, a line's its feature-edge marker; a point element makes its node a
@@ -11,11 +12,24 @@
 //! skipped. Node tags may be sparse and in any order: they are mapped to dense
 //! indices in the order of the file.
 //!
-//! The writer puts every region in its own volume entity with that region as
-//! physical tag, every face marker in a surface entity, every edge marker in a
-//! curve entity and every corner in a point entity (physical tag 1), so that
-//! Gmsh and meshio read the tags back.
+//! Nothing of the tagging is lost ([`read_with_meta`], [`MeshMeta`]):
+//! `$PhysicalNames` are kept (a name for a `(dim, tag)` no entity or element
+//! has is an error at its line); an entity in several physical groups keeps
+//! all of them: the mesh stores the first tag, and the full list is recorded
+//! for it (an entity whose first tag another entity's list starts with gets a
+//! fresh integer above all tags, with its list recorded). MSH 2.2, which
+//! lists an element once per physical group, has the copies merged by their
+//! nodes. Point elements' tags are kept by the coordinates of their node.
+//! `$NodeData` views become point fields (the last time step of each name;
+//! every node needs a finite value).
+//!
+//! The writer puts every stored value in its own entity with the physical
+//! tags behind it, every corner in a point entity (physical tag 1 when the
+//! input gave it none), writes the names of the groups that have entities,
+//! and point and cell fields of matching length as `$NodeData` and
+//! `$ElementData`, so that Gmsh and meshio read everything back.
 
+use super::meta::{assign_values, Field, MeshMeta};
 use super::{drop_unused_points, read_bytes, write_atomic, IoError};
 use crate::mesh::{MeshData, TetMesh};
 use std::collections::{BTreeMap, HashMap};
@@ -378,22 +392,104 @@ impl NodeIndex {
     }
 }
 
-/// Collects the elements of a file into [`MeshData`].
+/// The physical tags an element gets: an interned list of physical tags
+/// (`List`), or, without any, its entity's tag (`Plain`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum ElemTag {
+    List(u32),
+    Plain(i32),
+}
+
+/// A `$NodeData` view as read: node tags and values, with the line of its
+/// header for messages.
+struct NodeView {
+    name: String,
+    components: usize,
+    tags: Vec<u64>,
+    values: Vec<f64>,
+    line: usize,
+}
+
+/// Collects the elements of a file into [`MeshData`] and [`MeshMeta`].
 struct Collector {
     data: MeshData,
     nodes: Option<NodeIndex>,
     quadratic: bool,
     node_buf: Vec<u32>,
+    /// Interned physical tag lists.
+    lists: Vec<Vec<i32>>,
+    list_ids: HashMap<Vec<i32>, u32>,
+    tet_tags: Vec<ElemTag>,
+    tri_tags: Vec<ElemTag>,
+    edge_tags: Vec<ElemTag>,
+    corner_tags: Vec<ElemTag>,
+    /// MSH 2.2 writes an element once per physical group it is in: the
+    /// copies are merged by their nodes.
+    merge: bool,
+    seen_tets: HashMap<[u32; 4], u32>,
+    seen_tris: HashMap<[u32; 3], u32>,
+    seen_edges: HashMap<[u32; 2], u32>,
+    seen_corners: HashMap<u32, u32>,
+    /// Every `(dim, physical tag)` the file uses, for checking `$PhysicalNames`.
+    physicals: std::collections::BTreeSet<(i32, i32)>,
+    /// `$PhysicalNames` entries with their lines.
+    names: Vec<(i32, i32, String, usize)>,
+    views: Vec<NodeView>,
 }
 
 impl Collector {
-    fn new() -> Collector {
+    fn new(merge: bool) -> Collector {
         Collector {
             data: MeshData::default(),
             nodes: None,
             quadratic: false,
             node_buf: Vec::with_capacity(16),
+            lists: Vec::new(),
+            list_ids: HashMap::new(),
+            tet_tags: Vec::new(),
+            tri_tags: Vec::new(),
+            edge_tags: Vec::new(),
+            corner_tags: Vec::new(),
+            merge,
+            seen_tets: HashMap::new(),
+            seen_tris: HashMap::new(),
+            seen_edges: HashMap::new(),
+            seen_corners: HashMap::new(),
+            physicals: Default::default(),
+            names: Vec::new(),
+            views: Vec::new(),
         }
+    }
+
+    /// The tag of an element with these physical tags (none: `entity`).
+    fn tag_of(&mut self, physical: &[i32], entity: i32) -> ElemTag {
+        if physical.is_empty() {
+            return ElemTag::Plain(entity);
+        }
+        if let Some(&id) = self.list_ids.get(physical) {
+            return ElemTag::List(id);
+        }
+        let id = self.lists.len() as u32;
+        self.lists.push(physical.to_vec());
+        self.list_ids.insert(physical.to_vec(), id);
+        ElemTag::List(id)
+    }
+
+    /// The tag of an element listed again with another physical tag (MSH
+    /// 2.2), or `None` when the copy brings no new tag (a true duplicate,
+    /// kept so that building the mesh reports it).
+    fn merged(&mut self, old: ElemTag, new: ElemTag) -> Option<ElemTag> {
+        let (ElemTag::List(a), ElemTag::List(b)) = (old, new) else {
+            return None;
+        };
+        let mut l = self.lists[a as usize].clone();
+        let before = l.len();
+        for &p in &self.lists[b as usize] {
+            if !l.contains(&p) {
+                l.push(p);
+            }
+        }
+        (l.len() > before).then(|| self.tag_of(&l, 0))
     }
 
     /// Reads `k` node tags of one element with `read` and maps them.
@@ -422,34 +518,84 @@ impl Collector {
     }
 
     /// Adds the element whose nodes are in `node_buf`.
-    fn add(
-        &mut self,
-        role: Role,
-        etype: i64,
-        tag: i64,
-        c: &Cursor,
-        line: Option<usize>,
-    ) -> Result<(), IoError> {
-        let n = &self.node_buf;
+    fn add(&mut self, role: Role, etype: i64, tag: ElemTag, line: Option<usize>) {
+        let n = self.node_buf.clone();
         if matches!(etype, 8 | 9 | 11) {
             self.quadratic = true;
         }
-        let tag32 = i32::try_from(tag)
-            .map_err(|_| c.error(format!("tag {tag} does not fit a 32-bit integer")))?;
+        fn sorted<const N: usize>(mut a: [u32; N]) -> [u32; N] {
+            a.sort_unstable();
+            a
+        }
         match role {
             Role::Tet => {
-                self.data.tets.push([n[0], n[1], n[2], n[3]]);
-                self.data.tet_regions.push(tag32);
+                let v = [n[0], n[1], n[2], n[3]];
+                if self.merge {
+                    let i = self.data.tets.len() as u32;
+                    if let Some(&j) = self.seen_tets.get(&sorted(v)) {
+                        if let Some(m) = self.merged(self.tet_tags[j as usize], tag) {
+                            self.tet_tags[j as usize] = m;
+                            return;
+                        }
+                    } else {
+                        self.seen_tets.insert(sorted(v), i);
+                    }
+                }
+                self.data.tets.push(v);
+                self.tet_tags.push(tag);
                 if let Some(l) = line {
                     self.data.tet_lines.push(l as u32);
                 }
             }
-            Role::Triangle => self.data.triangles.push(([n[0], n[1], n[2]], tag32)),
-            Role::Edge => self.data.edges.push(([n[0], n[1]], tag32)),
-            Role::Corner => self.data.corners.push(n[0]),
+            Role::Triangle => {
+                let v = [n[0], n[1], n[2]];
+                if self.merge {
+                    let i = self.data.triangles.len() as u32;
+                    if let Some(&j) = self.seen_tris.get(&sorted(v)) {
+                        if let Some(m) = self.merged(self.tri_tags[j as usize], tag) {
+                            self.tri_tags[j as usize] = m;
+                            return;
+                        }
+                    } else {
+                        self.seen_tris.insert(sorted(v), i);
+                    }
+                }
+                self.data.triangles.push((v, 0));
+                self.tri_tags.push(tag);
+            }
+            Role::Edge => {
+                let v = [n[0], n[1]];
+                if self.merge {
+                    let i = self.data.edges.len() as u32;
+                    if let Some(&j) = self.seen_edges.get(&sorted(v)) {
+                        if let Some(m) = self.merged(self.edge_tags[j as usize], tag) {
+                            self.edge_tags[j as usize] = m;
+                            return;
+                        }
+                    } else {
+                        self.seen_edges.insert(sorted(v), i);
+                    }
+                }
+                self.data.edges.push((v, 0));
+                self.edge_tags.push(tag);
+            }
+            Role::Corner => {
+                if self.merge {
+                    let i = self.data.corners.len() as u32;
+                    if let Some(&j) = self.seen_corners.get(&n[0]) {
+                        if let Some(m) = self.merged(self.corner_tags[j as usize], tag) {
+                            self.corner_tags[j as usize] = m;
+                            return;
+                        }
+                    } else {
+                        self.seen_corners.insert(n[0], i);
+                    }
+                }
+                self.data.corners.push(n[0]);
+                self.corner_tags.push(tag);
+            }
             Role::Skip => {}
         }
-        Ok(())
     }
 
     fn set_nodes(
@@ -466,7 +612,44 @@ impl Collector {
         Ok(())
     }
 
-    fn finish(mut self, path: &Path) -> Result<MeshData, IoError> {
+    /// The stored values of one dimension's elements, with the tag sets
+    /// behind them recorded in `meta`.
+    fn values(&self, dim: i32, tags: &[ElemTag], meta: &mut MeshMeta) -> Vec<i32> {
+        let mut order: Vec<u32> = Vec::new();
+        let mut pos: HashMap<u32, usize> = HashMap::new();
+        let mut reserved = std::collections::BTreeSet::new();
+        for t in tags {
+            match *t {
+                ElemTag::List(id) => {
+                    pos.entry(id).or_insert_with(|| {
+                        order.push(id);
+                        order.len() - 1
+                    });
+                }
+                ElemTag::Plain(v) => {
+                    reserved.insert(v);
+                }
+            }
+        }
+        let lists: Vec<Vec<i32>> = order
+            .iter()
+            .map(|&id| self.lists[id as usize].clone())
+            .collect();
+        let values = assign_values(&lists, &reserved);
+        for (l, &v) in lists.iter().zip(&values) {
+            if l.as_slice() != [v] {
+                meta.tag_sets.insert((dim, v), l.clone());
+            }
+        }
+        tags.iter()
+            .map(|t| match *t {
+                ElemTag::List(id) => values[pos[&id]],
+                ElemTag::Plain(v) => v,
+            })
+            .collect()
+    }
+
+    fn finish(mut self, path: &Path) -> Result<(MeshData, MeshMeta), IoError> {
         if self.nodes.is_none() {
             return Err(IoError::file(path, "no $Nodes section"));
         }
@@ -476,18 +659,121 @@ impl Collector {
                 "no tetrahedra (element type 4 or 11): not a volume mesh",
             ));
         }
+        for (dim, tag, name, line) in &self.names {
+            if !self.physicals.contains(&(*dim, *tag)) {
+                return Err(IoError::at(
+                    path,
+                    *line,
+                    format!(
+                        "$PhysicalNames names physical tag {tag} of dimension {dim} (\"{name}\"), which no entity or element of the file has"
+                    ),
+                ));
+            }
+        }
+        let mut meta = MeshMeta::default();
+        for (dim, tag, name, _) in &self.names {
+            meta.physical_names.insert((*dim, *tag), name.clone());
+        }
+        self.data.tet_regions = self.values(3, &self.tet_tags, &mut meta);
+        let tri = self.values(2, &self.tri_tags, &mut meta);
+        for (t, v) in self.data.triangles.iter_mut().zip(tri) {
+            t.1 = v;
+        }
+        let edge = self.values(1, &self.edge_tags, &mut meta);
+        for (e, v) in self.data.edges.iter_mut().zip(edge) {
+            e.1 = v;
+        }
+        for (&v, t) in self.data.corners.iter().zip(&self.corner_tags) {
+            if let ElemTag::List(id) = *t {
+                meta.point_tags.push((
+                    self.data.points[v as usize],
+                    self.lists[id as usize].clone(),
+                ));
+            }
+        }
         if self.data.tet_lines.len() != self.data.tets.len() {
             self.data.tet_lines.clear();
         }
-        if self.quadratic {
-            drop_unused_points(&mut self.data);
+        let index = self.nodes.take().expect("checked above");
+        let np = self.data.points.len();
+        // Views: the last one of each name (the last time step) covers every node.
+        let mut by_name: BTreeMap<String, usize> = BTreeMap::new();
+        for (i, v) in self.views.iter().enumerate() {
+            by_name.insert(v.name.clone(), i);
         }
-        Ok(self.data)
+        let mut keep: Vec<usize> = by_name.into_values().collect();
+        keep.sort_unstable();
+        for i in keep {
+            let v = &self.views[i];
+            let mut values = vec![f64::NAN; np * v.components];
+            let mut have = vec![false; np];
+            for (k, &tag) in v.tags.iter().enumerate() {
+                let Some(n) = index.get(tag) else {
+                    return Err(IoError::at(
+                        path,
+                        v.line,
+                        format!(
+                            "$NodeData \"{}\" refers to node {tag}, which is not defined in $Nodes",
+                            v.name
+                        ),
+                    ));
+                };
+                have[n as usize] = true;
+                values[n as usize * v.components..(n as usize + 1) * v.components]
+                    .copy_from_slice(&v.values[k * v.components..(k + 1) * v.components]);
+            }
+            let missing = have.iter().filter(|&&h| !h).count();
+            if missing > 0 {
+                return Err(IoError::at(
+                    path,
+                    v.line,
+                    format!(
+                        "$NodeData \"{}\" has values for {} of the {np} nodes ({missing} missing): a field must cover every node",
+                        v.name,
+                        np - missing
+                    ),
+                ));
+            }
+            meta.point_fields.push(Field {
+                name: v.name.clone(),
+                components: v.components,
+                values,
+            });
+        }
+        if self.quadratic {
+            let before = self.data.points.clone();
+            drop_unused_points(&mut self.data);
+            if self.data.points.len() != before.len() && !meta.point_fields.is_empty() {
+                // Kept points stay in order: match them up in one pass.
+                let mut kept = Vec::with_capacity(self.data.points.len());
+                let mut j = 0;
+                for (i, p) in before.iter().enumerate() {
+                    if j < self.data.points.len() && self.data.points[j] == *p {
+                        kept.push(i);
+                        j += 1;
+                    }
+                }
+                for f in &mut meta.point_fields {
+                    let c = f.components;
+                    f.values = kept
+                        .iter()
+                        .flat_map(|&i| f.values[i * c..(i + 1) * c].to_vec())
+                        .collect();
+                }
+            }
+        }
+        Ok((self.data, meta))
     }
 }
 
 /// Reads a Gmsh `.msh` file (MSH 2.2 or 4.1, ASCII or binary).
 pub fn read(path: &Path) -> Result<MeshData, IoError> {
+    read_with_meta(path).map(|(d, _)| d)
+}
+
+/// Reads a Gmsh `.msh` file with its physical names, full tag lists and
+/// `$NodeData` views (see [`MeshMeta`]).
+pub fn read_with_meta(path: &Path) -> Result<(MeshData, MeshMeta), IoError> {
     let bytes = read_bytes(path)?;
     if bytes.iter().all(|c| c.is_ascii_whitespace()) {
         return Err(IoError::file(path, "empty file"));
@@ -533,13 +819,15 @@ pub fn read(path: &Path) -> Result<MeshData, IoError> {
     }
     c.expect("$EndMeshFormat")?;
     c.binary = file_type == 1;
-    let mut col = Collector::new();
-    let mut physical: HashMap<(i64, i64), i64> = HashMap::new();
+    let mut col = Collector::new(v2);
+    let mut physical: HashMap<(i64, i64), ElemTag> = HashMap::new();
     while let Some(section) = c.maybe_token()? {
         match section {
+            "$PhysicalNames" => read_physical_names(&mut c, &mut col)?,
+            "$NodeData" => read_node_data(&mut c, &mut col)?,
             "$Nodes" if v2 => read_nodes_v2(&mut c, &mut col)?,
             "$Elements" if v2 => read_elements_v2(&mut c, &mut col)?,
-            "$Entities" if !v2 => read_entities_v41(&mut c, &mut physical)?,
+            "$Entities" if !v2 => read_entities_v41(&mut c, &mut col, &mut physical)?,
             "$Nodes" => read_nodes_v41(&mut c, &mut col)?,
             "$Elements" => read_elements_v41(&mut c, &mut col, &physical)?,
             s if s.starts_with('$') && !s.starts_with("$End") && s.len() > 1 => {
@@ -568,6 +856,148 @@ fn end_section(c: &mut Cursor, kw: &str) -> Result<(), IoError> {
     }
 }
 
+/// The rest of a `"quoted"` token that started with `first` (names may hold
+/// blanks): the text between the quotes.
+fn quoted(c: &mut Cursor, first: &str, what: &str) -> Result<String, IoError> {
+    let Some(rest) = first.strip_prefix('"') else {
+        return Err(c.error(format!(
+            "expected {what} in double quotes, found '{}'",
+            shorten(first)
+        )));
+    };
+    let mut s = rest.to_string();
+    let line = c.last_line;
+    loop {
+        if let Some(body) = s.strip_suffix('"') {
+            return Ok(body.to_string());
+        }
+        let t = c.token(what)?;
+        if c.last_line != line {
+            return Err(c.error_at(
+                line,
+                c.last_pos,
+                format!("{what} has no closing double quote on its line"),
+            ));
+        }
+        s.push(' ');
+        s.push_str(t);
+    }
+}
+
+/// `$PhysicalNames` (ASCII in every variant): `dim tag "name"` per line.
+fn read_physical_names(c: &mut Cursor, col: &mut Collector) -> Result<(), IoError> {
+    let binary = c.binary;
+    c.binary = false;
+    let n = c.count("the physical name count", 6)?;
+    for _ in 0..n {
+        let dim: i32 = c.parse("a physical dimension")?;
+        let line = c.last_line;
+        if !(0..=3).contains(&dim) {
+            return Err(c.error(format!("physical dimension {dim} is not 0..3")));
+        }
+        let tag: i32 = c.parse("a physical tag")?;
+        let t = c.token("a physical name")?;
+        let name = quoted(c, t, "a physical name")?;
+        if col.names.iter().any(|(d, g, _, _)| (*d, *g) == (dim, tag)) {
+            return Err(c.error(format!(
+                "physical tag {tag} of dimension {dim} is named twice"
+            )));
+        }
+        col.names.push((dim, tag, name, line));
+    }
+    end_section(c, "$EndPhysicalNames")?;
+    c.binary = binary;
+    Ok(())
+}
+
+/// `$NodeData`: a view's string, real and integer tags in ASCII, then one
+/// node tag and `components` doubles per entry (binary in binary files, with
+/// an `int` tag in MSH 2.2 and 4.1 alike, as Gmsh 4.15 writes them).
+fn read_node_data(c: &mut Cursor, col: &mut Collector) -> Result<(), IoError> {
+    let binary = c.binary;
+    c.binary = false;
+    let ns = c.count("the string tag count", 2)?;
+    let mut name = String::from("field");
+    for i in 0..ns {
+        let t = c.token("a string tag")?;
+        let s = quoted(c, t, "a string tag")?;
+        if i == 0 {
+            name = s;
+        }
+    }
+    let nr = c.count("the real tag count", 2)?;
+    for _ in 0..nr {
+        c.double("a real tag")?;
+    }
+    let ni = c.count("the integer tag count", 2)?;
+    let mut ints = Vec::with_capacity(ni);
+    let mut line = c.last_line;
+    for i in 0..ni {
+        ints.push(c.parse::<i64>("an integer tag")?);
+        if i <= 2 {
+            // The line of the entry count, for messages about the entries.
+            line = c.last_line;
+        }
+    }
+    let (components, n) = match ints.as_slice() {
+        [_, comp, n, ..] => (*comp, *n),
+        _ => {
+            return Err(
+                c.error("$NodeData needs three integer tags (time step, components, entries)")
+            )
+        }
+    };
+    if !(1..=9).contains(&components) {
+        return Err(c.error(format!(
+            "$NodeData \"{name}\": {components} components per node is not valid (1 to 9)"
+        )));
+    }
+    let components = components as usize;
+    let left = (c.b.len() - c.pos) as i64;
+    if n < 0 || n > left / (2 * components as i64 + 2) + 1 {
+        return Err(c.error(format!(
+            "$NodeData \"{name}\": {n} entries is more than the rest of the file can hold"
+        )));
+    }
+    c.binary = binary;
+    if binary {
+        c.line_end()?;
+    }
+    let mut tags = Vec::with_capacity(n as usize);
+    let mut values = Vec::with_capacity(n as usize * components);
+    for _ in 0..n {
+        let tag = if binary {
+            let t = c.int("a node tag")?;
+            if t < 0 {
+                u64::MAX
+            } else {
+                t as u64
+            }
+        } else {
+            c.parse::<u64>("a node tag")?
+        };
+        tags.push(tag);
+        for _ in 0..components {
+            let x = c.double("a field value")?;
+            if !x.is_finite() {
+                return Err(c.error(format!(
+                    "$NodeData \"{name}\": value {x} at node {tag} is not a finite number"
+                )));
+            }
+            values.push(x);
+        }
+    }
+    end_section(c, "$EndNodeData")?;
+    col.views.push(NodeView {
+        name,
+        components,
+        tags,
+        values,
+        line,
+    });
+    Ok(())
+}
+
 fn read_nodes_v2(c: &mut Cursor, col: &mut Collector) -> Result<(), IoError> {
     let binary = c.binary;
     c.binary = false;
@@ -593,12 +1023,48 @@ fn read_nodes_v2(c: &mut Cursor, col: &mut Collector) -> Result<(), IoError> {
     col.set_nodes(c, &tags, coords)
 }
 
+/// An `i64` tag as the `i32` the mesh stores.
+fn tag32(c: &Cursor, tag: i64) -> Result<i32, IoError> {
+    i32::try_from(tag).map_err(|_| c.error(format!("tag {tag} does not fit a 32-bit integer")))
+}
+
+/// The dimension of the elements of a role.
+fn dim_of(role: Role) -> Option<i32> {
+    match role {
+        Role::Tet => Some(3),
+        Role::Triangle => Some(2),
+        Role::Edge => Some(1),
+        Role::Corner => Some(0),
+        Role::Skip => None,
+    }
+}
+
+/// Dimension of an element type, for element types we skip.
+fn dim_of_type(t: i64) -> Option<i32> {
+    Some(match t {
+        15 => 0,
+        1 | 8 | 26 | 27 | 28 => 1,
+        2 | 3 | 9 | 10 | 16 | 20..=25 => 2,
+        4..=7 | 11..=14 | 17..=19 | 29..=31 | 92 | 93 => 3,
+        _ => return None,
+    })
+}
+
 /// MSH 2.2 tags: physical first (0 for none), then elementary.
-fn region_v2(tags: &[i64]) -> i64 {
-    match tags {
-        [p, ..] if *p != 0 => *p,
-        [_, e, ..] => *e,
-        _ => 0,
+fn tag_v2(c: &Cursor, col: &mut Collector, etype: i64, tags: &[i64]) -> Result<ElemTag, IoError> {
+    let (p, e) = match tags {
+        [p, e, ..] => (*p, *e),
+        [p] => (*p, 0),
+        [] => (0, 0),
+    };
+    let (p, e) = (tag32(c, p)?, tag32(c, e)?);
+    if p != 0 {
+        if let Some(d) = dim_of_type(etype) {
+            col.physicals.insert((d, p));
+        }
+        Ok(col.tag_of(&[p], e))
+    } else {
+        Ok(ElemTag::Plain(e))
     }
 }
 
@@ -636,8 +1102,8 @@ fn read_elements_v2(c: &mut Cursor, col: &mut Collector) -> Result<(), IoError> 
                     let t = c.int("a node tag")?;
                     Ok(if t < 0 { u64::MAX } else { t as u64 })
                 })?;
-                let r = region_v2(&tags);
-                col.add(role, etype, r, c, None)?;
+                let tag = tag_v2(c, col, etype, &tags)?;
+                col.add(role, etype, tag, None);
             }
             done += count as usize;
         }
@@ -653,6 +1119,7 @@ fn read_elements_v2(c: &mut Cursor, col: &mut Collector) -> Result<(), IoError> 
             }
             let role = role_of_type(etype);
             if role == Role::Skip {
+                tag_v2(c, col, etype, &tags)?;
                 c.skip_line();
                 continue;
             }
@@ -668,8 +1135,8 @@ fn read_elements_v2(c: &mut Cursor, col: &mut Collector) -> Result<(), IoError> 
                     "element of type {etype} has more than {k} nodes on its line"
                 )));
             }
-            let r = region_v2(&tags);
-            col.add(role, etype, r, c, Some(line))?;
+            let tag = tag_v2(c, col, etype, &tags)?;
+            col.add(role, etype, tag, Some(line));
         }
     }
     end_section(c, "$EndElements")
@@ -677,7 +1144,8 @@ fn read_elements_v2(c: &mut Cursor, col: &mut Collector) -> Result<(), IoError> 
 
 fn read_entities_v41(
     c: &mut Cursor,
-    physical: &mut HashMap<(i64, i64), i64>,
+    col: &mut Collector,
+    physical: &mut HashMap<(i64, i64), ElemTag>,
 ) -> Result<(), IoError> {
     if c.binary {
         c.line_end()?;
@@ -694,6 +1162,7 @@ fn read_entities_v41(
             8,
         )?;
     }
+    let mut tags = Vec::new();
     for (dim, &n) in counts.iter().enumerate() {
         for _ in 0..n {
             let tag = c.int("an entity tag")?;
@@ -702,11 +1171,20 @@ fn read_entities_v41(
                 c.double("a bounding-box coordinate")?;
             }
             let nphys = c.count("a physical tag count", 4)?;
-            for i in 0..nphys {
+            tags.clear();
+            for _ in 0..nphys {
                 let p = c.int("a physical tag")?;
-                if i == 0 {
-                    physical.insert((dim as i64, tag), p);
+                let p = tag32(c, p)?;
+                col.physicals.insert((dim as i32, p));
+                if !tags.contains(&p) {
+                    tags.push(p);
                 }
+            }
+            let t = col.tag_of(&tags, tag32(c, tag)?);
+            if physical.insert((dim as i64, tag), t).is_some() {
+                return Err(c.error(format!(
+                    "entity {tag} of dimension {dim} is defined twice in $Entities"
+                )));
             }
             if dim > 0 {
                 let nb = c.count("a bounding entity count", 4)?;
@@ -774,7 +1252,7 @@ fn read_nodes_v41(c: &mut Cursor, col: &mut Collector) -> Result<(), IoError> {
 fn read_elements_v41(
     c: &mut Cursor,
     col: &mut Collector,
-    physical: &HashMap<(i64, i64), i64>,
+    physical: &HashMap<(i64, i64), ElemTag>,
 ) -> Result<(), IoError> {
     if c.binary {
         c.line_end()?;
@@ -797,7 +1275,22 @@ fn read_elements_v41(
             )));
         }
         let role = role_of_type(etype);
-        let tag_value = physical.get(&(dim, tag)).copied().unwrap_or(tag);
+        if let Some(d) = dim_of(role) {
+            if i64::from(d) != dim {
+                return Err(c.error(format!(
+                    "element type {etype} is of dimension {d}, but its block is on an entity of dimension {dim}"
+                )));
+            }
+        }
+        let tag_value = match physical.get(&(dim, tag)) {
+            Some(&t) => t,
+            None if physical.is_empty() => ElemTag::Plain(tag32(c, tag)?),
+            None => {
+                return Err(c.error(format!(
+                "element block on entity {tag} of dimension {dim}, which $Entities does not define"
+            )))
+            }
+        };
         let Some(nodes) = nodes_of_type(etype) else {
             if c.binary {
                 return Err(c.error(format!("unknown element type {etype}")));
@@ -829,7 +1322,7 @@ fn read_elements_v41(
                 )));
             }
             let l = (!c.binary).then_some(line);
-            col.add(role, etype, tag_value, c, l)?;
+            col.add(role, etype, tag_value, l);
         }
     }
     if total != n {
@@ -842,30 +1335,86 @@ fn read_elements_v41(
     end_section(c, "$EndElements")
 }
 
+/// The MSH variant [`write_with`] writes.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum MshFormat {
+    /// MSH 2.2 ASCII: an element in several physical groups is written once
+    /// per group, as Gmsh itself does.
+    V22,
+    /// MSH 4.1 ASCII (the default).
+    #[default]
+    V41,
+    /// MSH 4.1 binary (little-endian, 8-byte `size_t`).
+    V41Binary,
+}
+
+impl std::str::FromStr for MshFormat {
+    type Err = String;
+
+    fn from_str(s: &str) -> Result<MshFormat, String> {
+        match s {
+            "2.2" => Ok(MshFormat::V22),
+            "4.1" => Ok(MshFormat::V41),
+            "4.1-binary" => Ok(MshFormat::V41Binary),
+            other => Err(format!(
+                "unknown MSH format '{other}' (use 2.2, 4.1 or 4.1-binary)"
+            )),
+        }
+    }
+}
+
+impl std::fmt::Display for MshFormat {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            MshFormat::V22 => "2.2",
+            MshFormat::V41 => "4.1",
+            MshFormat::V41Binary => "4.1-binary",
+        })
+    }
+}
+
 /// Writes `mesh` as Gmsh MSH 4.1 ASCII (through a temporary file).
 pub fn write(path: &Path, mesh: &TetMesh) -> Result<(), IoError> {
     write_data(path, &mesh.to_data())
 }
 
-/// Physical tag of the point entities that carry corners: corners have no
-/// marker of their own, but meshio needs every entity to have a physical tag
-/// once any has one.
+/// Writes `mesh` with its side table (physical names, tag lists, fields) in
+/// the chosen MSH variant.
+pub fn write_with(
+    path: &Path,
+    mesh: &TetMesh,
+    meta: &MeshMeta,
+    format: MshFormat,
+) -> Result<(), IoError> {
+    write_data_with(path, &mesh.to_data(), meta, format)
+}
+
+/// Physical tag of the point entities that carry corners the input gave no
+/// tag: corners have no marker of their own, but meshio needs every entity
+/// to have a physical tag once any has one.
 const CORNER_PHYSICAL: i32 = 1;
 
-/// One entity of the written file: its physical tag and the elements in it.
+/// One entity of the written file: its physical tags and the elements in it.
 struct Entity<E> {
-    physical: i32,
+    physical: Vec<i32>,
     elements: Vec<E>,
 }
 
-fn group<E: Copy>(items: impl Iterator<Item = (E, i32)>) -> Vec<Entity<E>> {
+fn group<E: Copy>(
+    dim: i32,
+    meta: &MeshMeta,
+    items: impl Iterator<Item = (E, i32)>,
+) -> Vec<Entity<E>> {
     let mut by_tag: BTreeMap<i32, Vec<E>> = BTreeMap::new();
     for (e, t) in items {
         by_tag.entry(t).or_default().push(e);
     }
     by_tag
         .into_iter()
-        .map(|(physical, elements)| Entity { physical, elements })
+        .map(|(value, elements)| Entity {
+            physical: meta.physical_tags(dim, value),
+            elements,
+        })
         .collect()
 }
 
@@ -893,101 +1442,404 @@ fn bounding_box(points: &[[f64; 3]], nodes: impl Iterator<Item = u32>) -> [f64; 
 
 /// Writes plain mesh data as Gmsh MSH 4.1 ASCII.
 pub fn write_data(path: &Path, d: &MeshData) -> Result<(), IoError> {
-    let volumes = group(d.tets.iter().enumerate().map(|(t, v)| (*v, d.region(t))));
-    let surfaces = group(d.triangles.iter().copied());
-    let curves = group(d.edges.iter().copied());
-    let mut corners = d.corners.clone();
-    corners.sort_unstable();
-    corners.dedup();
-    let n_elements = d.tets.len() + d.triangles.len() + d.edges.len() + corners.len();
-    let n_blocks = volumes.len() + surfaces.len() + curves.len() + corners.len();
+    write_data_with(path, d, &MeshMeta::default(), MshFormat::V41)
+}
+
+/// Values of one line of a 4.1 file, written as ASCII tokens or as binary
+/// `int` / `size_t` / `double`.
+struct Emit<'w, W: Write> {
+    w: &'w mut W,
+    binary: bool,
+    first: bool,
+}
+
+impl<W: Write> Emit<'_, W> {
+    fn sep(&mut self) -> std::io::Result<()> {
+        if !self.first {
+            self.w.write_all(b" ")?;
+        }
+        self.first = false;
+        Ok(())
+    }
+    fn int(&mut self, v: i64) -> std::io::Result<()> {
+        if self.binary {
+            self.w.write_all(&(v as i32).to_le_bytes())
+        } else {
+            self.sep()?;
+            write!(self.w, "{v}")
+        }
+    }
+    fn size(&mut self, v: u64) -> std::io::Result<()> {
+        if self.binary {
+            self.w.write_all(&v.to_le_bytes())
+        } else {
+            self.sep()?;
+            write!(self.w, "{v}")
+        }
+    }
+    fn dbl(&mut self, v: f64) -> std::io::Result<()> {
+        if self.binary {
+            self.w.write_all(&v.to_le_bytes())
+        } else {
+            self.sep()?;
+            write!(self.w, "{v:?}")
+        }
+    }
+    /// Ends a line (ASCII only).
+    fn nl(&mut self) -> std::io::Result<()> {
+        self.first = true;
+        if self.binary {
+            Ok(())
+        } else {
+            self.w.write_all(b"\n")
+        }
+    }
+    /// Ends the binary block of a section: a line end before `$End…`.
+    fn end(&mut self) -> std::io::Result<()> {
+        self.first = true;
+        if self.binary {
+            self.w.write_all(b"\n")
+        } else {
+            Ok(())
+        }
+    }
+}
+
+/// Writes plain mesh data and its side table in the chosen MSH variant.
+pub fn write_data_with(
+    path: &Path,
+    d: &MeshData,
+    meta: &MeshMeta,
+    format: MshFormat,
+) -> Result<(), IoError> {
+    let volumes = group(
+        3,
+        meta,
+        d.tets.iter().enumerate().map(|(t, v)| (*v, d.region(t))),
+    );
+    let surfaces = group(2, meta, d.triangles.iter().copied());
+    let curves = group(1, meta, d.edges.iter().copied());
+    let mut corner_ids = d.corners.clone();
+    corner_ids.sort_unstable();
+    corner_ids.dedup();
+    let corners: Vec<Entity<u32>> = corner_ids
+        .iter()
+        .map(|&v| Entity {
+            physical: meta
+                .point_physical_tags(d.points[v as usize])
+                .map(<[i32]>::to_vec)
+                .unwrap_or_else(|| vec![CORNER_PHYSICAL]),
+            elements: vec![v],
+        })
+        .collect();
+    // Names of the physical groups that have entities in the file.
+    let mut used: std::collections::BTreeSet<(i32, i32)> = Default::default();
+    for (dim, list) in corners
+        .iter()
+        .map(|e| (0, &e.physical))
+        .chain(curves.iter().map(|e| (1, &e.physical)))
+        .chain(surfaces.iter().map(|e| (2, &e.physical)))
+        .chain(volumes.iter().map(|e| (3, &e.physical)))
+    {
+        for &p in list {
+            used.insert((dim, p));
+        }
+    }
+    let names: Vec<(&(i32, i32), &String)> = meta
+        .physical_names
+        .iter()
+        .filter(|(k, _)| used.contains(k))
+        .collect();
     let np = d.points.len();
+    let nt = d.tets.len();
+    let point_fields: Vec<&Field> = meta
+        .point_fields
+        .iter()
+        .filter(|f| f.len() == np && f.values.len() == np * f.components)
+        .collect();
+    let cell_fields: Vec<&Field> = meta
+        .cell_fields
+        .iter()
+        .filter(|f| f.len() == nt && f.values.len() == nt * f.components)
+        .collect();
     write_atomic(path, |w| {
-        writeln!(w, "$MeshFormat\n4.1 0 8\n$EndMeshFormat")?;
-        writeln!(w, "$Entities")?;
-        writeln!(
-            w,
-            "{} {} {} {}",
-            corners.len(),
-            curves.len(),
-            surfaces.len(),
-            volumes.len()
-        )?;
-        for (i, &v) in corners.iter().enumerate() {
-            let p = d.points[v as usize];
-            writeln!(
-                w,
-                "{} {:?} {:?} {:?} 1 {CORNER_PHYSICAL}",
-                i + 1,
-                p[0],
-                p[1],
-                p[2]
-            )?;
-        }
-        let write_box = |w: &mut dyn Write, tag: usize, b: [f64; 6], physical: i32| {
-            writeln!(
-                w,
-                "{tag} {:?} {:?} {:?} {:?} {:?} {:?} 1 {physical} 0",
-                b[0], b[1], b[2], b[3], b[4], b[5]
-            )
-        };
-        for (i, e) in curves.iter().enumerate() {
-            let b = bounding_box(&d.points, e.elements.iter().flatten().copied());
-            write_box(w, i + 1, b, e.physical)?;
-        }
-        for (i, e) in surfaces.iter().enumerate() {
-            let b = bounding_box(&d.points, e.elements.iter().flatten().copied());
-            write_box(w, i + 1, b, e.physical)?;
-        }
-        for (i, e) in volumes.iter().enumerate() {
-            let b = bounding_box(&d.points, e.elements.iter().flatten().copied());
-            write_box(w, i + 1, b, e.physical)?;
-        }
-        writeln!(w, "$EndEntities")?;
-        // All nodes in one block on the first volume entity; Gmsh and meshio
-        // look nodes up by tag, whatever entity they are classified on.
-        writeln!(w, "$Nodes\n1 {np} 1 {np}\n3 1 0 {np}")?;
-        for i in 1..=np {
-            writeln!(w, "{i}")?;
-        }
-        for p in &d.points {
-            writeln!(w, "{:?} {:?} {:?}", p[0], p[1], p[2])?;
-        }
-        writeln!(w, "$EndNodes")?;
-        writeln!(w, "$Elements\n{n_blocks} {n_elements} 1 {n_elements}")?;
-        let mut tag = 0usize;
-        for (i, &v) in corners.iter().enumerate() {
-            tag += 1;
-            writeln!(w, "0 {} 15 1\n{tag} {}", i + 1, v + 1)?;
-        }
-        for (i, e) in curves.iter().enumerate() {
-            writeln!(w, "1 {} 1 {}", i + 1, e.elements.len())?;
-            for v in &e.elements {
-                tag += 1;
-                writeln!(w, "{tag} {} {}", v[0] + 1, v[1] + 1)?;
+        match format {
+            MshFormat::V22 => writeln!(w, "$MeshFormat\n2.2 0 8\n$EndMeshFormat")?,
+            MshFormat::V41 => writeln!(w, "$MeshFormat\n4.1 0 8\n$EndMeshFormat")?,
+            MshFormat::V41Binary => {
+                writeln!(w, "$MeshFormat\n4.1 1 8")?;
+                w.write_all(&1i32.to_le_bytes())?;
+                writeln!(w, "\n$EndMeshFormat")?;
             }
         }
-        for (i, e) in surfaces.iter().enumerate() {
-            writeln!(w, "2 {} 2 {}", i + 1, e.elements.len())?;
-            for v in &e.elements {
-                tag += 1;
-                writeln!(w, "{tag} {} {} {}", v[0] + 1, v[1] + 1, v[2] + 1)?;
+        if !names.is_empty() {
+            writeln!(w, "$PhysicalNames\n{}", names.len())?;
+            for ((dim, tag), name) in &names {
+                writeln!(w, "{dim} {tag} \"{name}\"")?;
             }
+            writeln!(w, "$EndPhysicalNames")?;
         }
-        for (i, e) in volumes.iter().enumerate() {
-            writeln!(w, "3 {} 4 {}", i + 1, e.elements.len())?;
-            for v in &e.elements {
-                tag += 1;
-                writeln!(
-                    w,
-                    "{tag} {} {} {} {}",
-                    v[0] + 1,
-                    v[1] + 1,
-                    v[2] + 1,
-                    v[3] + 1
+        // Element tag of each tet (for $ElementData), in mesh order.
+        let mut tet_tag = vec![0u64; nt];
+        if format == MshFormat::V22 {
+            writeln!(w, "$Nodes\n{np}")?;
+            for (i, p) in d.points.iter().enumerate() {
+                writeln!(w, "{} {:?} {:?} {:?}", i + 1, p[0], p[1], p[2])?;
+            }
+            writeln!(w, "$EndNodes")?;
+            fn count<E>(es: &[Entity<E>]) -> usize {
+                es.iter().map(|e| e.physical.len() * e.elements.len()).sum()
+            }
+            let n = count(&corners) + count(&curves) + count(&surfaces) + count(&volumes);
+            writeln!(w, "$Elements\n{n}")?;
+            let mut num = 0usize;
+            let mut line = |w: &mut dyn Write, etype: u8, phys: i32, ent: usize, nodes: &[u32]| {
+                num += 1;
+                write!(w, "{num} {etype} 2 {phys} {ent}")?;
+                for v in nodes {
+                    write!(w, " {}", v + 1)?;
+                }
+                writeln!(w).map(|_| num)
+            };
+            for (i, e) in corners.iter().enumerate() {
+                for &p in &e.physical {
+                    line(w, 15, p, i + 1, &e.elements)?;
+                }
+            }
+            for (i, e) in curves.iter().enumerate() {
+                for &p in &e.physical {
+                    for v in &e.elements {
+                        line(w, 1, p, i + 1, v)?;
+                    }
+                }
+            }
+            for (i, e) in surfaces.iter().enumerate() {
+                for &p in &e.physical {
+                    for v in &e.elements {
+                        line(w, 2, p, i + 1, v)?;
+                    }
+                }
+            }
+            let mut tet_of: HashMap<[u32; 4], usize> = HashMap::new();
+            if !cell_fields.is_empty() {
+                tet_of = d.tets.iter().enumerate().map(|(t, v)| (*v, t)).collect();
+            }
+            for (i, e) in volumes.iter().enumerate() {
+                for (k, &p) in e.physical.iter().enumerate() {
+                    for v in &e.elements {
+                        let num = line(w, 4, p, i + 1, v)?;
+                        if k == 0 {
+                            if let Some(&t) = tet_of.get(v) {
+                                tet_tag[t] = num as u64;
+                            }
+                        }
+                    }
+                }
+            }
+            writeln!(w, "$EndElements")?;
+        } else {
+            let binary = format == MshFormat::V41Binary;
+            let mut e = Emit {
+                w: &mut *w,
+                binary,
+                first: true,
+            };
+            writeln!(e.w, "$Entities")?;
+            for n in [corners.len(), curves.len(), surfaces.len(), volumes.len()] {
+                e.size(n as u64)?;
+            }
+            e.nl()?;
+            for (i, c) in corners.iter().enumerate() {
+                let p = d.points[c.elements[0] as usize];
+                e.int(i as i64 + 1)?;
+                for x in p {
+                    e.dbl(x)?;
+                }
+                e.size(c.physical.len() as u64)?;
+                for &t in &c.physical {
+                    e.int(t.into())?;
+                }
+                e.nl()?;
+            }
+            fn boxed<W: Write, E: Copy + IntoIterator<Item = u32>>(
+                e: &mut Emit<W>,
+                points: &[[f64; 3]],
+                es: &[Entity<E>],
+            ) -> std::io::Result<()> {
+                for (i, ent) in es.iter().enumerate() {
+                    let b = bounding_box(points, ent.elements.iter().flat_map(|x| *x));
+                    e.int(i as i64 + 1)?;
+                    for x in b {
+                        e.dbl(x)?;
+                    }
+                    e.size(ent.physical.len() as u64)?;
+                    for &t in &ent.physical {
+                        e.int(t.into())?;
+                    }
+                    e.size(0)?;
+                    e.nl()?;
+                }
+                Ok(())
+            }
+            boxed(&mut e, &d.points, &curves)?;
+            boxed(&mut e, &d.points, &surfaces)?;
+            boxed(&mut e, &d.points, &volumes)?;
+            e.end()?;
+            writeln!(e.w, "$EndEntities")?;
+            // All nodes in one block on the first volume entity; Gmsh and
+            // meshio look nodes up by tag, whatever entity they are on.
+            writeln!(e.w, "$Nodes")?;
+            for n in [1, np as u64, 1, np as u64] {
+                e.size(n)?;
+            }
+            e.nl()?;
+            e.int(3)?;
+            e.int(1)?;
+            e.int(0)?;
+            e.size(np as u64)?;
+            e.nl()?;
+            for i in 1..=np {
+                e.size(i as u64)?;
+                e.nl()?;
+            }
+            for p in &d.points {
+                for x in p {
+                    e.dbl(*x)?;
+                }
+                e.nl()?;
+            }
+            e.end()?;
+            writeln!(e.w, "$EndNodes")?;
+            let n_elements = nt + d.triangles.len() + d.edges.len() + corners.len();
+            let n_blocks = volumes.len() + surfaces.len() + curves.len() + corners.len();
+            writeln!(e.w, "$Elements")?;
+            for n in [n_blocks as u64, n_elements as u64, 1, n_elements as u64] {
+                e.size(n)?;
+            }
+            e.nl()?;
+            let mut tag = 0u64;
+            let mut block = |e: &mut Emit<_>,
+                             dim: i64,
+                             ent: usize,
+                             etype: i64,
+                             elements: &mut dyn Iterator<Item = &[u32]>,
+                             count: usize,
+                             tags_out: &mut Vec<u64>|
+             -> std::io::Result<()> {
+                e.int(dim)?;
+                e.int(ent as i64)?;
+                e.int(etype)?;
+                e.size(count as u64)?;
+                e.nl()?;
+                for nodes in elements {
+                    tag += 1;
+                    tags_out.push(tag);
+                    e.size(tag)?;
+                    for &v in nodes {
+                        e.size(u64::from(v) + 1)?;
+                    }
+                    e.nl()?;
+                }
+                Ok(())
+            };
+            let mut sink = Vec::new();
+            for (i, c) in corners.iter().enumerate() {
+                block(
+                    &mut e,
+                    0,
+                    i + 1,
+                    15,
+                    &mut std::iter::once(&c.elements[..]),
+                    1,
+                    &mut sink,
                 )?;
             }
+            for (i, c) in curves.iter().enumerate() {
+                let n = c.elements.len();
+                block(
+                    &mut e,
+                    1,
+                    i + 1,
+                    1,
+                    &mut c.elements.iter().map(|x| &x[..]),
+                    n,
+                    &mut sink,
+                )?;
+            }
+            for (i, c) in surfaces.iter().enumerate() {
+                let n = c.elements.len();
+                block(
+                    &mut e,
+                    2,
+                    i + 1,
+                    2,
+                    &mut c.elements.iter().map(|x| &x[..]),
+                    n,
+                    &mut sink,
+                )?;
+            }
+            let mut vol_tags: Vec<u64> = Vec::with_capacity(nt);
+            for (i, c) in volumes.iter().enumerate() {
+                let n = c.elements.len();
+                block(
+                    &mut e,
+                    3,
+                    i + 1,
+                    4,
+                    &mut c.elements.iter().map(|x| &x[..]),
+                    n,
+                    &mut vol_tags,
+                )?;
+            }
+            e.end()?;
+            writeln!(e.w, "$EndElements")?;
+            if !cell_fields.is_empty() {
+                // Volumes list the tets grouped by region, in mesh order within each.
+                let mut order: Vec<usize> = (0..nt).collect();
+                order.sort_by_key(|&t| d.region(t));
+                for (k, &t) in order.iter().enumerate() {
+                    tet_tag[t] = vol_tags[k];
+                }
+            }
         }
-        writeln!(w, "$EndElements")
+        let binary = format == MshFormat::V41Binary;
+        let data_block = |w: &mut dyn Write,
+                          section: &str,
+                          f: &Field,
+                          n: usize,
+                          tag_of: &dyn Fn(usize) -> u64|
+         -> std::io::Result<()> {
+            writeln!(
+                w,
+                "${section}\n1\n\"{}\"\n1\n0.0\n3\n0\n{}\n{n}",
+                f.name.replace('"', "'"),
+                f.components
+            )?;
+            for i in 0..n {
+                if binary {
+                    w.write_all(&(tag_of(i) as i32).to_le_bytes())?;
+                    for x in f.entry(i) {
+                        w.write_all(&x.to_le_bytes())?;
+                    }
+                } else {
+                    write!(w, "{}", tag_of(i))?;
+                    for x in f.entry(i) {
+                        write!(w, " {x:?}")?;
+                    }
+                    writeln!(w)?;
+                }
+            }
+            if binary {
+                writeln!(w)?;
+            }
+            writeln!(w, "$End{section}")
+        };
+        for f in &point_fields {
+            data_block(w, "NodeData", f, np, &|i| i as u64 + 1)?;
+        }
+        for f in &cell_fields {
+            data_block(w, "ElementData", f, nt, &|i| tet_tag[i])?;
+        }
+        Ok(())
     })
 }

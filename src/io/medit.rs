@@ -4,7 +4,11 @@
 //! `Triangles` (ref → face marker), `Edges` (→ feature edges; every listed edge
 //! is a feature, as MMG writes ridges and required edges there), `Ridges`,
 //! `RequiredEdges`, `Corners`, `RequiredVertices`. Sections of other element
-//! kinds and attribute tables are skipped. Written: the same sections.
+//! kinds and attribute tables are skipped; so are keywords of other tools
+//! (`TetrahedraP2`, `Identifier`, `SubDomainFromGeom`, `AngleOfCorner`, …)
+//! after `MeshVersionFormatted`, with one note on stderr naming them. A
+//! malformed known section is still an error at its line. Written: the same
+//! sections. Binary `.meshb` is [`super::meshb`].
 //! [`read_surface`] reads a triangles-only file as a surface to mesh.
 
 use super::plc::Plc;
@@ -69,10 +73,15 @@ fn parse(path: &Path) -> Result<MeshData, IoError> {
     let mut raw_edges: Vec<([u32; 2], i32)> = Vec::new();
     let mut saw_vertices = false;
     let mut saw_any = false;
+    let mut saw_version = false;
+    let mut skipped: Vec<String> = Vec::new();
     while let Some(kw) = tok.next() {
         saw_any = true;
         match kw {
-            "MeshVersionFormatted" => read_version(&mut tok)?,
+            "MeshVersionFormatted" => {
+                read_version(&mut tok)?;
+                saw_version = true;
+            }
             "Dimension" => {
                 let d: i64 = tok.parse("the dimension")?;
                 if d != 3 {
@@ -176,17 +185,47 @@ fn parse(path: &Path) -> Result<MeshData, IoError> {
                         }
                     }
                 }
-                None => {
+                None if !saw_version => {
                     return Err(tok.error(format!(
-                        "unknown keyword '{}' (not a Medit .mesh file, or an unsupported section)",
+                        "unknown keyword '{}' before MeshVersionFormatted (not a Medit .mesh file)",
                         other.chars().take(32).collect::<String>()
                     )))
+                }
+                None => {
+                    // Another tool's keyword (TetrahedraP2, Identifier,
+                    // AngleOfCorner, …): skipped up to the next keyword, as
+                    // libMeshb itself finds keywords (a token that starts
+                    // with a letter); quoted strings are skipped whole.
+                    let name = other.chars().take(32).collect::<String>();
+                    if !skipped.contains(&name) {
+                        skipped.push(name);
+                    }
+                    while let Some(t) = tok.peek() {
+                        if t.starts_with(|c: char| c.is_ascii_alphabetic()) {
+                            break;
+                        }
+                        let t = tok.next().unwrap_or_default();
+                        if t.starts_with('"') && !(t.len() > 1 && t.ends_with('"')) {
+                            while let Some(u) = tok.next() {
+                                if u.ends_with('"') {
+                                    break;
+                                }
+                            }
+                        }
+                    }
                 }
             },
         }
     }
     if !saw_any {
         return Err(IoError::file(path, "empty file"));
+    }
+    if !skipped.is_empty() {
+        eprintln!(
+            "note: {}: skipped sections tetrefine does not use: {}",
+            path.display(),
+            skipped.join(", ")
+        );
     }
     data.edges = raw_edges;
     Ok(data)

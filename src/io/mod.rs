@@ -7,10 +7,13 @@
 //! [`write_atomic`], so a failed write never leaves a partial file behind.
 
 pub mod edges;
+pub mod fields;
 pub mod gid;
 pub mod gmsh;
 pub mod indicator;
 pub mod medit;
+pub mod meshb;
+pub mod meta;
 pub mod off;
 pub mod plc;
 pub mod poly;
@@ -39,6 +42,8 @@ use std::path::Path;
 pub enum Format {
     /// Medit / MMG `.mesh` (ASCII).
     Medit,
+    /// Medit / MMG binary `.meshb` (libMeshb versions 1–4; writes version 2).
+    Meshb,
     /// Gmsh `.msh`, 2.2 or 4.1, ASCII or binary (writes 4.1 ASCII).
     Gmsh,
     /// GiD `.msh` (reads only).
@@ -61,6 +66,7 @@ impl Format {
     pub fn for_reading(path: &Path) -> Result<Format, IoError> {
         match extension(path).as_str() {
             "mesh" => Ok(Format::Medit),
+            "meshb" => Ok(Format::Meshb),
             "vtu" => Ok(Format::Vtu),
             "node" | "ele" | "face" | "edge" => Ok(Format::Tetgen),
             "msh" => {
@@ -88,11 +94,11 @@ impl Format {
             }
             "" => Err(IoError::file(
                 path,
-                "has no extension; use .mesh, .msh, .vtu, .node or .ele",
+                "has no extension; use .mesh, .meshb, .msh, .vtu, .node or .ele",
             )),
             other => Err(IoError::file(
                 path,
-                format!("unknown mesh extension '.{other}'; use .mesh, .msh, .vtu, .node or .ele"),
+                format!("unknown mesh extension '.{other}'; use .mesh, .meshb, .msh, .vtu, .node or .ele"),
             )),
         }
     }
@@ -101,12 +107,13 @@ impl Format {
     pub fn for_writing(path: &Path) -> Result<Format, IoError> {
         match extension(path).as_str() {
             "mesh" => Ok(Format::Medit),
+            "meshb" => Ok(Format::Meshb),
             "vtu" => Ok(Format::Vtu),
             "msh" => Ok(Format::Gmsh),
             "node" | "ele" => Ok(Format::Tetgen),
             other => Err(IoError::file(
                 path,
-                format!("cannot write '.{other}'; use .mesh, .msh (Gmsh 4.1), .vtu or .node/.ele (TetGen)"),
+                format!("cannot write '.{other}'; use .mesh, .meshb, .msh (Gmsh), .vtu or .node/.ele (TetGen)"),
             )),
         }
     }
@@ -170,6 +177,7 @@ fn read_mesh_file(path: &Path) -> Result<(MeshData, Vec<String>), IoError> {
     let plain = |d: MeshData| (d, Vec::new());
     match Format::for_reading(path)? {
         Format::Medit => medit::read(path).map(plain),
+        Format::Meshb => meshb::read(path).map(plain),
         Format::Gmsh => gmsh::read(path).map(plain),
         Format::Gid => gid::read(path).map(plain),
         Format::Vtu => vtk::read_noted(path).map(|(d, n)| (d, n.into_iter().collect())),
@@ -192,10 +200,81 @@ pub fn load_mesh_noted(
     Ok((mesh, report, notes))
 }
 
+/// Reads a mesh with its side table ([`meta::MeshMeta`]: Gmsh physical names
+/// and tag lists, point and cell arrays); formats without one give an empty
+/// table.
+pub fn read_mesh_with_meta(path: &Path) -> Result<(MeshData, meta::MeshMeta), IoError> {
+    read_mesh_with_meta_noted(path).map(|(d, m, _)| (d, m))
+}
+
+/// [`read_mesh_with_meta`], and the reader's notes (see [`read_mesh_noted`]).
+pub fn read_mesh_with_meta_noted(
+    path: &Path,
+) -> Result<(MeshData, meta::MeshMeta, Vec<String>), IoError> {
+    if Format::for_reading(path)? == Format::Gmsh {
+        let meta = std::fs::metadata(path).map_err(|e| IoError::os(path, None, e))?;
+        let (d, m) = if meta.is_file() {
+            gmsh::read_with_meta(path)?
+        } else {
+            spooled(path, gmsh::read_with_meta)?
+        };
+        return Ok((d, m, Vec::new()));
+    }
+    let (d, notes) = read_mesh_noted(path)?;
+    Ok((d, meta::MeshMeta::default(), notes))
+}
+
+/// [`load_mesh`] with the side table of [`read_mesh_with_meta`].
+pub fn load_mesh_with_meta(
+    path: &Path,
+) -> Result<(TetMesh, crate::mesh::BuildReport, meta::MeshMeta), IoError> {
+    load_mesh_with_meta_noted(path).map(|(m, r, t, _)| (m, r, t))
+}
+
+/// [`load_mesh_with_meta`], and the reader's notes (see [`read_mesh_noted`]).
+pub fn load_mesh_with_meta_noted(
+    path: &Path,
+) -> Result<
+    (
+        TetMesh,
+        crate::mesh::BuildReport,
+        meta::MeshMeta,
+        Vec<String>,
+    ),
+    IoError,
+> {
+    let (data, meta, notes) = read_mesh_with_meta_noted(path)?;
+    let (mesh, report) = TetMesh::from_data(&data)
+        .map_err(|e| IoError::content(path, e.line().map(|l| l as usize), e))?;
+    Ok((mesh, report, meta, notes))
+}
+
+/// How [`write_mesh_with`] writes what the extension leaves open.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct WriteOptions {
+    /// The MSH variant of a `.msh` output.
+    pub msh_format: gmsh::MshFormat,
+}
+
+/// [`write_mesh`] with a side table: Gmsh output gets its physical names,
+/// tag lists and fields (`$NodeData`, `$ElementData`) back.
+pub fn write_mesh_with(
+    path: &Path,
+    mesh: &TetMesh,
+    meta: &meta::MeshMeta,
+    options: &WriteOptions,
+) -> Result<(), IoError> {
+    match Format::for_writing(path)? {
+        Format::Gmsh => gmsh::write_with(path, mesh, meta, options.msh_format),
+        _ => write_mesh(path, mesh),
+    }
+}
+
 /// Writes `mesh` in the format given by the extension of `path`.
 pub fn write_mesh(path: &Path, mesh: &TetMesh) -> Result<(), IoError> {
     match Format::for_writing(path)? {
         Format::Medit => medit::write(path, mesh),
+        Format::Meshb => meshb::write(path, mesh, 2),
         Format::Gmsh => gmsh::write(path, mesh),
         Format::Vtu => vtk::write_vtu(path, mesh, None, &[]),
         Format::Tetgen => tetgen::write(path, mesh),

@@ -5,6 +5,7 @@
 mod support;
 
 mod indicator;
+mod medit_tolerant;
 mod plc_readers;
 mod regions;
 mod roundtrip;

@@ -16,9 +16,14 @@ struct Carries {
     corners: bool,
 }
 
-const FORMATS: [Carries; 4] = [
+const FORMATS: [Carries; 5] = [
     Carries {
         ext: "mesh",
+        faces_and_edges: true,
+        corners: true,
+    },
+    Carries {
+        ext: "meshb",
         faces_and_edges: true,
         corners: true,
     },

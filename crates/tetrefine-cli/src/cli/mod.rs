@@ -34,7 +34,15 @@ pub type CliResult = Result<(), String>;
 
 /// Loads a mesh, telling the user on stderr what building changed.
 pub fn load(path: &std::path::Path) -> Result<tetrefine::TetMesh, String> {
-    let (mesh, report, notes) = tetrefine::io::load_mesh_noted(path).map_err(|e| e.to_string())?;
+    load_with_meta(path).map(|(m, _)| m)
+}
+
+/// [`load`] with the file's side table (physical names, tag lists, fields).
+pub fn load_with_meta(
+    path: &std::path::Path,
+) -> Result<(tetrefine::TetMesh, tetrefine::io::meta::MeshMeta), String> {
+    let (mesh, report, meta, notes) =
+        tetrefine::io::load_mesh_with_meta_noted(path).map_err(|e| e.to_string())?;
     for n in notes {
         eprintln!("note: {}: {n}", path.display());
     }
@@ -56,7 +64,7 @@ pub fn load(path: &std::path::Path) -> Result<tetrefine::TetMesh, String> {
             report.dropped_edges
         );
     }
-    Ok(mesh)
+    Ok((mesh, meta))
 }
 
 /// Checks a histogram path's extension before any work is done.
@@ -77,11 +85,14 @@ pub type TetValue<'a> = dyn Fn(&TetMesh, u32) -> i32 + Sync + 'a;
 
 /// Writes a refined mesh: compacted, and for `.vtu` with the cell arrays
 /// `level` and `parent` (plus `extra`, named integers per tet) besides the
-/// standard quality arrays.
+/// standard quality arrays; other formats get the input's side table `meta`
+/// (physical names and tags) and the write `options` (the MSH variant).
 pub fn write_refined(
     path: &Path,
     mesh: &mut TetMesh,
     extra: &[(&str, &TetValue<'_>)],
+    meta: &tetrefine::io::meta::MeshMeta,
+    options: &tetrefine::io::WriteOptions,
 ) -> CliResult {
     mesh.compact();
     let is_vtu = path
@@ -112,7 +123,7 @@ pub fn write_refined(
         let summary = vtu_summary(&valence, &stats);
         tetrefine::io::vtk::write_vtu(path, mesh, Some(&summary), &cells).map_err(|e| e.to_string())
     } else {
-        tetrefine::io::write_mesh(path, mesh).map_err(|e| e.to_string())
+        tetrefine::io::write_mesh_with(path, mesh, meta, options).map_err(|e| e.to_string())
     }
 }
 
@@ -128,6 +139,19 @@ fn vtu_summary<'a>(valence: &'a [u32], stats: &'a MeshStats) -> VtuSummary<'a> {
 /// Writes `mesh` in the format of `path`'s extension; a `.vtu` also gets the
 /// point valences and the minimum-dihedral histogram of the statistics.
 pub fn write_mesh(path: &Path, mesh: &TetMesh) -> CliResult {
+    let (meta, options) = Default::default();
+    write_mesh_with(path, mesh, &meta, &options)
+}
+
+/// [`write_mesh`] with the input's side table `meta` (physical names and
+/// tags, fields) and the write `options` (the MSH variant) for formats that
+/// carry them.
+pub fn write_mesh_with(
+    path: &Path,
+    mesh: &TetMesh,
+    meta: &tetrefine::io::meta::MeshMeta,
+    options: &tetrefine::io::WriteOptions,
+) -> CliResult {
     let is_vtu = tetrefine::io::Format::for_writing(path).map_err(|e| e.to_string())?
         == tetrefine::io::Format::Vtu;
     if is_vtu {
@@ -135,7 +159,7 @@ pub fn write_mesh(path: &Path, mesh: &TetMesh) -> CliResult {
         let summary = vtu_summary(&valence, &stats);
         tetrefine::io::vtk::write_vtu(path, mesh, Some(&summary), &[]).map_err(|e| e.to_string())
     } else {
-        tetrefine::io::write_mesh(path, mesh).map_err(|e| e.to_string())
+        tetrefine::io::write_mesh_with(path, mesh, meta, options).map_err(|e| e.to_string())
     }
 }
 

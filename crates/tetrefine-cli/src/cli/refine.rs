@@ -103,6 +103,10 @@ pub struct Args {
     /// Accept `--steps 0` (the mesh is written unrefined, with its arrays).
     #[arg(long)]
     pub allow_steps_zero: bool,
+    /// MSH variant of a `.msh` output: 2.2, 4.1 or 4.1-binary. Physical
+    /// names and every physical tag of the input's entities are written back.
+    #[arg(long, default_value = "4.1")]
+    pub msh_format: tetrefine::io::gmsh::MshFormat,
 }
 
 /// Where the optimize phase may act in adaptive refinement.
@@ -179,7 +183,7 @@ pub fn run(a: Args) -> super::CliResult {
         tetrefine::polyline::PolylineFormat::of(f).map_err(|e| e.to_string())?;
     }
     let strategy = mark_strategy(&a)?;
-    let mut input = super::load(&a.input)?;
+    let (mut input, meta) = super::load_with_meta(&a.input)?;
     let selection = match &strategy {
         Some(st) => {
             let values = match &a.indicator {
@@ -279,7 +283,21 @@ pub fn run(a: Args) -> super::CliResult {
         let p = m.parent(t) as usize;
         i32::from(sel.is_none_or(|s| s.get(p).copied().unwrap_or(false)))
     };
-    super::write_refined(&a.output, &mut mesh, &[("marked", &marked)])?;
+    let options = tetrefine::io::WriteOptions {
+        msh_format: a.msh_format,
+    };
+    // Names and tag lists stay valid through refinement (every child keeps its
+    // parent's region and markers); the input's fields do not.
+    let mut meta = meta;
+    meta.point_fields.clear();
+    meta.cell_fields.clear();
+    super::write_refined(
+        &a.output,
+        &mut mesh,
+        &[("marked", &marked)],
+        &meta,
+        &options,
+    )?;
     if let Some(f) = &a.features_out {
         super::write_feature_lines(f, &mesh)?;
     }

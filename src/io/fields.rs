@@ -1,0 +1,95 @@
+//! Point and cell fields from and to Medit solutions (`--fields FILE.sol`,
+//! `--fields-out FILE.solb`), and their transfer from an input mesh to its
+//! refinement.
+
+use super::meshb::{read_sol, write_sol, SolAt, SolFile, Solution};
+use super::meta::MeshMeta;
+use super::IoError;
+use std::path::Path;
+
+/// The libMeshb solution type of a field with `components` values.
+fn kind_of(components: usize) -> Option<i32> {
+    match components {
+        1 => Some(1),
+        3 => Some(2),
+        6 => Some(3),
+        9 => Some(4),
+        _ => None,
+    }
+}
+
+/// Adds the solutions of a Medit `.sol` / `.solb` to `meta`: a
+/// `SolAtVertices` keyword's to the point fields (it must have `n_points`
+/// entries), a `SolAtTetrahedra` keyword's to the cell fields (`n_tets`).
+/// Fields are named after the file (`temperature.sol` → `temperature`,
+/// several solutions → `temperature_0`, …).
+pub fn add_sol_fields(
+    path: &Path,
+    meta: &mut MeshMeta,
+    n_points: usize,
+    n_tets: usize,
+) -> Result<(), IoError> {
+    let sol = read_sol(path)?;
+    let (want, what) = match sol.at {
+        SolAt::Vertices => (n_points, "points"),
+        SolAt::Tetrahedra => (n_tets, "tetrahedra"),
+    };
+    if sol.entries != want {
+        let message = format!(
+            "the solution has {} entries but the mesh has {want} {what}",
+            sol.entries
+        );
+        return Err(match sol.line {
+            Some(l) => IoError::at(path, l, message),
+            None => IoError::file(path, message),
+        });
+    }
+    let stem = path
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "sol".into());
+    let n = sol.solutions.len();
+    for (i, s) in sol.solutions.into_iter().enumerate() {
+        let mut f = s.field;
+        f.name = if n == 1 {
+            stem.clone()
+        } else {
+            format!("{stem}_{i}")
+        };
+        match sol.at {
+            SolAt::Vertices => meta.point_fields.push(f),
+            SolAt::Tetrahedra => meta.cell_fields.push(f),
+        }
+    }
+    Ok(())
+}
+
+/// Writes the point fields of `meta` (those with `n_points` entries and 1,
+/// 3, 6 or 9 components) as one `SolAtVertices` keyword: `.solb` binary
+/// (libMeshb version 2, as MMG writes), any other extension ASCII.
+pub fn write_point_fields(path: &Path, meta: &MeshMeta, n_points: usize) -> Result<(), IoError> {
+    let solutions: Vec<Solution> = meta
+        .point_fields
+        .iter()
+        .filter(|f| f.len() == n_points && f.values.len() == n_points * f.components)
+        .filter_map(|f| {
+            kind_of(f.components).map(|kind| Solution {
+                kind,
+                field: f.clone(),
+            })
+        })
+        .collect();
+    if solutions.is_empty() {
+        return Err(IoError::file(
+            path,
+            "the mesh carries no point field to write (give one with --fields FILE.sol, or read a .vtu/.msh with point data)",
+        ));
+    }
+    let sol = SolFile {
+        at: SolAt::Vertices,
+        entries: n_points,
+        solutions,
+        line: None,
+    };
+    write_sol(path, &sol, 2)
+}
