@@ -56,7 +56,7 @@ fn a_malformed_known_section_after_foreign_ones_is_still_an_error_at_its_line() 
         Some(last),
         "{err} (first TetrahedraP2 at {line:?})"
     );
-    assert!(err.message.contains("vertex index"), "{err}");
+    assert!(err.message().contains("vertex index"), "{err}");
 }
 
 #[test]
