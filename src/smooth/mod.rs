@@ -4,6 +4,7 @@
 //! The objective everywhere is the paper's quality: the minimum signed sine of
 //! the dihedral angles of a tet, and for a vertex the minimum over its ball.
 
+pub mod boundary_smooth;
 pub mod colour;
 pub mod improve;
 pub mod laplacian;
