@@ -69,6 +69,9 @@ impl Default for BoundarySmoothOptions {
     }
 }
 
+/// Below this worst min-sine a boundary move may lower its ball's mean.
+const SLIVER: f64 = 0.2;
+
 /// What a vertex may do.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Kind {
@@ -106,6 +109,17 @@ pub struct BoundarySmoother {
     /// reference polyline of a line vertex is gathered from here.
     line_nbrs: FastHashMap<u32, Vec<u32>>,
     opts: BoundarySmoothOptions,
+}
+
+/// The reference faces of one key near a vertex, and their plane if they
+/// are flat.
+struct RefSet {
+    key: Key,
+    faces: Vec<u32>,
+    /// Unit normal and a point, when every corner lies on one plane.
+    plane: Option<(DVec3, DVec3)>,
+    /// Per axis, the coordinate every corner shares (axis-aligned planes).
+    axes: [Option<f64>; 3],
 }
 
 /// What the boundary smoother did.
@@ -342,6 +356,44 @@ impl BoundarySmoother {
         }
     }
 
+    /// The reference sets of every key of `v`'s star.
+    fn ref_sets(&self, v: u32) -> Vec<RefSet> {
+        let mut keys: Vec<Key> = self.star(v).iter().map(|&f| self.keys[f as usize]).collect();
+        keys.sort_unstable();
+        keys.dedup();
+        keys.into_iter()
+            .map(|key| {
+                let mut faces = Vec::new();
+                self.ref_set(v, key, &mut faces);
+                let r = &self.ref_faces[faces[0] as usize];
+                let n = (r[1] - r[0]).cross(r[2] - r[0]);
+                let scale = (r[1] - r[0]).length().max((r[2] - r[0]).length());
+                let flat = n.length() > 0.0 && {
+                    let n = n.normalize();
+                    faces.iter().all(|&f| {
+                        self.ref_faces[f as usize]
+                            .iter()
+                            .all(|&p| (p - r[0]).dot(n).abs() <= 1e-12 * scale)
+                    })
+                };
+                let plane = flat.then(|| (n.normalize(), r[0]));
+                let axes = [0, 1, 2].map(|k| {
+                    let c = r[0][k];
+                    faces
+                        .iter()
+                        .all(|&f| self.ref_faces[f as usize].iter().all(|p| p[k] == c))
+                        .then_some(c)
+                });
+                RefSet {
+                    key,
+                    faces,
+                    plane,
+                    axes,
+                }
+            })
+            .collect()
+    }
+
     fn project_on(&self, x: DVec3, set: &[u32]) -> (DVec3, f64) {
         let mut best = (x, f64::INFINITY);
         for &f in set {
@@ -387,14 +439,17 @@ impl BoundarySmoother {
     /// sample points of each new constrained triangle against the reference
     /// faces of its key nearby, and the reference position of `v` against
     /// the new triangles.
-    fn deviation(&self, mesh: &TetMesh, v: u32, x: DVec3, scratch: &mut Vec<u32>) -> f64 {
+    fn deviation(&self, mesh: &TetMesh, v: u32, x: DVec3, sets: &[RefSet]) -> f64 {
         let mut dev: f64 = 0.0;
         let r0 = self.ref_pos.get(&v).copied().unwrap_or(x);
-        let mut keys: Vec<Key> = self.star(v).iter().map(|&f| self.keys[f as usize]).collect();
-        keys.sort_unstable();
-        keys.dedup();
-        for k in keys {
-            self.ref_set(v, k, scratch);
+        for rs in sets {
+            let (k, scratch) = (rs.key, &rs.faces);
+            if let Some((n, c)) = rs.plane {
+                // A flat reference: the new triangles lie in the star's
+                // polygon, in the plane, when their corners do.
+                dev = dev.max((x - c).dot(n).abs());
+                continue;
+            }
             let mut to_ref = f64::INFINITY;
             for &f in self.star(v) {
                 if self.keys[f as usize] != k {
@@ -446,9 +501,31 @@ impl BoundarySmoother {
 
     /// Projects a trial point for `v` onto its reference (triangles for a
     /// surface vertex, polyline for a line vertex).
-    fn project(&self, v: u32, x: DVec3, set: &[u32], line: &[[DVec3; 2]]) -> DVec3 {
+    fn project(
+        &self,
+        v: u32,
+        x: DVec3,
+        set: &[u32],
+        flat: Option<&RefSet>,
+        line: &[[DVec3; 2]],
+    ) -> DVec3 {
         match self.kind[v as usize] {
-            Kind::Surface => self.project_on(x, set).0,
+            Kind::Surface => match flat {
+                Some(RefSet {
+                    plane: Some((n, c)),
+                    axes,
+                    ..
+                }) => {
+                    let mut y = x - *n * (x - *c).dot(*n);
+                    for k in 0..3 {
+                        if let Some(a) = axes[k] {
+                            y[k] = a;
+                        }
+                    }
+                    y
+                }
+                _ => self.project_on(x, set).0,
+            },
             Kind::Line(..) => {
                 let mut best = (x, f64::INFINITY);
                 for s in line {
@@ -469,15 +546,15 @@ impl BoundarySmoother {
         }
     }
 
-    /// Tries to move `v` (ball `ball`); on success moves it and returns the
-    /// ball's new qualities (in ball order).
+    /// Where `v` (ball `ball`) should move, if anywhere: the new position
+    /// and the ball's qualities there (in ball order). Reads only the ball.
     pub fn smooth_vertex(
         &self,
-        mesh: &mut TetMesh,
+        mesh: &TetMesh,
         v: u32,
         ball: &[u32],
         bp: &mut BallPoints,
-    ) -> Option<Vec<f64>> {
+    ) -> Option<(DVec3, Vec<f64>)> {
         let kind = self.kind[v as usize];
         if !matches!(kind, Kind::Surface | Kind::Line(..)) || ball.is_empty() {
             return None;
@@ -499,10 +576,18 @@ impl BoundarySmoother {
             }
             _ => line = self.ref_polyline(v),
         }
+        let set = &set[..];
+        let line = &line[..];
         let cap = self.cap(mesh, v);
-        let mut scratch = Vec::new();
-        // Evaluates a projected trial point: (min, mean) if it is valid.
-        let eval = |y: DVec3, scratch: &mut Vec<u32>| -> Option<(f64, f64)> {
+        let sets = self.ref_sets(v);
+        let flat = match kind {
+            Kind::Surface => sets.first().filter(|r| r.plane.is_some()),
+            _ => None,
+        };
+        let mut scratch = ();
+        // Evaluates a projected trial point: (min, mean) if it is valid and
+        // passes `want` (checked before the costlier tests).
+        let eval = |y: DVec3, _: &mut (), want: &dyn Fn(f64, f64) -> bool| -> Option<(f64, f64)> {
             let mut q = f64::INFINITY;
             let mut sum = 0.0;
             for i in 0..bp.len() {
@@ -513,13 +598,14 @@ impl BoundarySmoother {
                 q = q.min(s);
                 sum += s;
             }
-            if !bp.stays_positive(y) {
+            let m = sum / bp.len() as f64;
+            if !want(q, m) || !bp.stays_positive(y) {
                 return None;
             }
-            if self.deviation(mesh, v, y, scratch) > cap {
+            if self.deviation(mesh, v, y, &sets) > cap {
                 return None;
             }
-            Some((q, sum / bp.len() as f64))
+            Some((q, m))
         };
         // Surface neighbours (the link of the star, or the line neighbours).
         let mut nbrs: Vec<u32> = Vec::new();
@@ -540,22 +626,24 @@ impl BoundarySmoother {
             let (q, m) = cand;
             let (bq, bm) = best.map_or((q0, m0), |b| (b.1, b.2));
             if q0 < self.opts.threshold {
-                q > bq + 1e-12 || (q >= bq && best.is_some() && m > bm + 1e-12)
+                // The mean may fall only to save a sliver (below 0.2, about
+                // 11.5°): elsewhere a move raising the worst at the cost of
+                // the mean would lower the average.
+                (m >= m0 || q0 < SLIVER)
+                    && (q > bq + 1e-12 || (q >= bq && best.is_some() && m > bm + 1e-12))
             } else {
                 q >= q0 && m > bm + 1e-12 && (best.is_none() || q >= bq - 1e-12)
             }
         };
         // 1. Tangential Laplacian (and halfway to it).
         let centroid = nbrs.iter().map(|&u| mesh.point(u)).sum::<DVec3>() / nbrs.len() as f64;
-        for w in [1.0, 0.5, 0.25] {
-            let y = self.project(v, x0 + w * (centroid - x0), &set, &line);
+        for w in [1.0, 0.5] {
+            let y = self.project(v, x0 + w * (centroid - x0), set, flat, line);
             if y == x0 {
                 continue;
             }
-            if let Some(c) = eval(y, &mut scratch) {
-                if better(c, &best) {
-                    best = Some((y, c.0, c.1));
-                }
+            if let Some(c) = eval(y, &mut scratch, &|q, m| better((q, m), &best)) {
+                best = Some((y, c.0, c.1));
             }
         }
         // 2. For poor balls: projected max-min ascent (active-set gradient,
@@ -566,17 +654,15 @@ impl BoundarySmoother {
                     for u in [a, b] {
                         let pu = mesh.point(u);
                         for s in [0.03, 0.06, 0.1, 0.15, 0.2, 0.27, 0.35, 0.45] {
-                            let y = self.project(v, x0 + s * (pu - x0), &set, &line);
-                            if let Some(c) = eval(y, &mut scratch) {
-                                if better(c, &best) {
-                                    best = Some((y, c.0, c.1));
-                                }
+                            let y = self.project(v, x0 + s * (pu - x0), set, flat, line);
+                            if let Some(c) = eval(y, &mut scratch, &|q, m| better((q, m), &best)) {
+                                best = Some((y, c.0, c.1));
                             }
                         }
                     }
                 }
                 _ => {
-                    let (mut x, mut q, mut m) = best.unwrap_or((x0, q0, m0));
+                    let (mut x, mut q, mut _m) = best.unwrap_or((x0, q0, m0));
                     let scale = nbrs
                         .iter()
                         .map(|&u| (mesh.point(u) - x0).length())
@@ -584,11 +670,17 @@ impl BoundarySmoother {
                         / nbrs.len() as f64;
                     let h = 1e-6 * scale;
                     let mut grads = Vec::new();
-                    for _ in 0..10 {
+                    for _ in 0..8 {
                         // Tangent plane: normal of the nearest reference face.
-                        let normal = {
+                        let normal = if let Some(RefSet {
+                            plane: Some((n, _)),
+                            ..
+                        }) = flat
+                        {
+                            *n
+                        } else {
                             let mut bestf = (DVec3::Z, f64::INFINITY);
-                            for &f in &set {
+                            for &f in set {
                                 let r = &self.ref_faces[f as usize];
                                 let y = closest_on_triangle(x, r[0], r[1], r[2]);
                                 let d = (y - x).length_squared();
@@ -623,13 +715,16 @@ impl BoundarySmoother {
                         let mut alpha = 0.2 * scale / dn;
                         let mut moved = false;
                         for _ in 0..8 {
-                            let y = self.project(v, x + alpha * d, &set, &line);
-                            if let Some((qy, my)) = eval(y, &mut scratch) {
-                                if qy > q + 1e-12 {
+                            let y = self.project(v, x + alpha * d, set, flat, line);
+                            if let Some((qy, my)) = eval(y, &mut scratch, &|qy, _| qy > q + 1e-12) {
+                                {
                                     x = y;
                                     q = qy;
-                                    m = my;
+                                    _m = my;
                                     moved = true;
+                                    if better((q, my), &best) {
+                                        best = Some((x, q, my));
+                                    }
                                     break;
                                 }
                             }
@@ -639,36 +734,48 @@ impl BoundarySmoother {
                             break;
                         }
                     }
-                    if x != x0 && better((q, m), &best) {
-                        best = Some((x, q, m));
-                    }
+
                 }
             }
         }
         let (x, _, _) = best?;
-        mesh.set_point(v, x);
-        Some((0..bp.len()).map(|i| bp.quality(i, x)).collect())
+        Some((x, (0..bp.len()).map(|i| bp.quality(i, x)).collect()))
     }
 
-    /// One pass over `verts` (in the given order): returns the report and
-    /// the tets whose quality changed with their new quality.
+    /// One pass over `verts`, by colour classes (no two vertices of a class
+    /// share a tet, so a class's moves are decided in parallel on the mesh
+    /// as it stands and applied in order: the result does not depend on the
+    /// number of threads). Returns the tets whose quality changed with their
+    /// new quality.
     pub fn pass(
         &self,
         mesh: &mut TetMesh,
         verts: &[u32],
         report: &mut BoundarySmoothReport,
     ) -> Vec<(u32, f64)> {
+        use rayon::prelude::*;
         let mut changed = Vec::new();
-        let mut ball = Vec::new();
-        let mut bp = BallPoints::default();
-        for &v in verts {
-            mesh.ball(v, &mut ball);
-            if let Some(qs) = self.smooth_vertex(mesh, v, &ball, &mut bp) {
+        for class in super::colour::colour_classes(mesh, verts) {
+            let m = &*mesh;
+            let moves: Vec<Option<(u32, DVec3, Vec<u32>, Vec<f64>)>> = class
+                .par_iter()
+                .with_min_len(16)
+                .map_init(
+                    || (Vec::new(), BallPoints::default()),
+                    |(ball, bp), &v| {
+                        m.ball(v, ball);
+                        self.smooth_vertex(m, v, ball, bp)
+                            .map(|(x, qs)| (v, x, ball.clone(), qs))
+                    },
+                )
+                .collect();
+            for (v, x, ball, qs) in moves.into_iter().flatten() {
+                mesh.set_point(v, x);
                 match self.kind[v as usize] {
                     Kind::Line(..) => report.line_moves += 1,
                     _ => report.surface_moves += 1,
                 }
-                changed.extend(ball.iter().copied().zip(qs));
+                changed.extend(ball.into_iter().zip(qs));
             }
         }
         changed

@@ -6,11 +6,13 @@
 
 pub mod boundary_smooth;
 pub mod colour;
+pub mod effort;
 pub mod improve;
 pub mod laplacian;
 pub mod optimize;
 pub mod ring;
 
+pub use effort::Effort;
 pub use improve::{fixed_vertices, improve, ImproveOptions, ImproveReport};
 
 use crate::geom::{orient3d, tet_min_sine};
