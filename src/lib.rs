@@ -27,16 +27,18 @@
 
 #![warn(missing_docs)]
 
+pub mod file;
 pub mod geom;
+pub mod improve;
 pub mod io;
 pub mod mesh;
 pub mod ops;
 pub mod refine;
 pub mod report;
-pub mod smooth;
-pub mod surface;
+pub mod stencil;
 #[cfg(feature = "tetgen")]
 pub mod tetgen;
+pub mod topo;
 
 pub use mesh::{MeshData, TetMesh};
 pub use report::MeshStats;

@@ -3,8 +3,5 @@
 pub mod predicates;
 pub mod quality;
 
-pub use predicates::{orient3d, orient3d_sign, Orientation};
-pub use quality::{
-    dihedral_angles, tet_min_sine, tet_quality, tet_volume, TetQuality, TET_EDGES,
-    TET_EDGE_OPPOSITE, TET_FACES,
-};
+pub use predicates::{all_positive, is_positive, orient3d, orient3d_sign, Orientation};
+pub use quality::{dihedral_angles, tet_min_sine, tet_quality, tet_volume, TetQuality};

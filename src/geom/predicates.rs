@@ -55,6 +55,20 @@ pub fn orient3d_sign(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> Orientation {
     }
 }
 
+/// Whether the tet with corners `p` is positively oriented (exact predicate):
+/// neither inverted nor flat. Every operation checks its new tets with this.
+#[inline]
+pub fn is_positive(p: &[DVec3; 4]) -> bool {
+    orient3d(p[0], p[1], p[2], p[3]) > 0.0
+}
+
+/// Whether every tet (as its four corners) is positively oriented: the one
+/// "all tets positive" check of the crate.
+#[inline]
+pub fn all_positive(tets: impl IntoIterator<Item = [DVec3; 4]>) -> bool {
+    tets.into_iter().all(|p| is_positive(&p))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

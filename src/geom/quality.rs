@@ -1,9 +1,7 @@
 //! Dihedral angles, the signed minimum-sine quality measure and volumes.
 //!
-//! Local numbering: vertices `0..4`, face `f` is opposite vertex `f`, and the six
-//! edges are listed in [`TET_EDGES`]; edge `e` joins `TET_EDGES[e]` and is the
-//! intersection of the faces opposite the two other vertices
-//! ([`TET_EDGE_OPPOSITE`]).
+//! Local numbering: that of [`crate::topo`] (sketch below); face `f` is
+//! opposite vertex `f`.
 //!
 //! ```text
 //!            3
@@ -29,16 +27,8 @@
 //! the minimum over the six edges, 0.9428 (= sin 70.53°) for the regular tet,
 //! negative for an inverted one.
 
+use crate::topo::{TET_EDGES, TET_EDGE_OPPOSITE};
 use glam::DVec3;
-
-/// The six edges of a tet as pairs of local vertex indices.
-pub const TET_EDGES: [[usize; 2]; 6] = [[0, 1], [0, 2], [0, 3], [1, 2], [1, 3], [2, 3]];
-/// For each edge of [`TET_EDGES`], the two local vertices not on it (the faces
-/// opposite those two vertices meet along the edge).
-pub const TET_EDGE_OPPOSITE: [[usize; 2]; 6] = [[2, 3], [1, 3], [1, 2], [0, 3], [0, 2], [0, 1]];
-/// Face `f` (opposite local vertex `f`), ordered so that its right-hand normal
-/// points out of a positively oriented tet.
-pub const TET_FACES: [[usize; 3]; 4] = [[1, 2, 3], [0, 3, 2], [0, 1, 3], [0, 2, 1]];
 
 /// Shape figures of one tetrahedron.
 #[derive(Clone, Copy, Debug, PartialEq)]

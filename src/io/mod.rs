@@ -18,56 +18,17 @@ pub mod tetgen;
 mod text;
 pub mod vtk;
 
-pub(crate) use text::as_text;
 pub use text::Tokens;
 
+pub(crate) use crate::file::{open_message, read_bytes};
+/// The file helpers (errors, whole-file reads, atomic writes) live below
+/// every area, in [`crate::file`], so that report and the surface schemes
+/// share them without going through `io`.
+pub use crate::file::{write_atomic, IoError};
+
 use crate::mesh::{MeshData, TetMesh};
-use std::fmt;
 use std::fs::File;
-use std::io::{BufWriter, Write};
-use std::path::{Path, PathBuf};
-
-/// A file that could not be read or written, with the place and the problem.
-#[derive(Debug, Clone, PartialEq)]
-pub struct IoError {
-    /// The file.
-    pub path: PathBuf,
-    /// 1-based line, when the problem has one.
-    pub line: Option<usize>,
-    /// What is wrong, in one sentence.
-    pub message: String,
-}
-
-impl IoError {
-    /// An error at a line of a file.
-    pub fn at(path: &Path, line: usize, message: impl Into<String>) -> IoError {
-        IoError {
-            path: path.to_path_buf(),
-            line: Some(line),
-            message: message.into(),
-        }
-    }
-
-    /// An error about a whole file.
-    pub fn file(path: &Path, message: impl Into<String>) -> IoError {
-        IoError {
-            path: path.to_path_buf(),
-            line: None,
-            message: message.into(),
-        }
-    }
-}
-
-impl fmt::Display for IoError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self.line {
-            Some(l) => write!(f, "{}:{}: {}", self.path.display(), l, self.message),
-            None => write!(f, "{}: {}", self.path.display(), self.message),
-        }
-    }
-}
-
-impl std::error::Error for IoError {}
+use std::path::Path;
 
 /// The mesh formats this crate reads and writes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -145,20 +106,6 @@ impl Format {
             )),
         }
     }
-}
-
-/// A readable sentence for a failed open.
-pub(crate) fn open_message(e: &std::io::Error) -> String {
-    match e.kind() {
-        std::io::ErrorKind::NotFound => "no such file".to_string(),
-        std::io::ErrorKind::PermissionDenied => "permission denied".to_string(),
-        _ => e.to_string(),
-    }
-}
-
-/// Reads the whole file, with a clear error.
-pub(crate) fn read_bytes(path: &Path) -> Result<Vec<u8>, IoError> {
-    std::fs::read(path).map_err(|e| IoError::file(path, open_message(&e)))
 }
 
 /// Reads a mesh, choosing the format by extension.
@@ -241,33 +188,4 @@ pub(crate) fn drop_unused_points(d: &mut MeshData) {
     d.corners.iter_mut().for_each(map);
     d.required_vertices.iter_mut().for_each(map);
     d.points = points;
-}
-
-/// Writes through a temporary file beside `path` and renames it into place,
-/// so that a failure (or a crash) never leaves a partial output file.
-pub fn write_atomic(
-    path: &Path,
-    body: impl FnOnce(&mut BufWriter<File>) -> std::io::Result<()>,
-) -> Result<(), IoError> {
-    let dir = path
-        .parent()
-        .filter(|p| !p.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_else(|| "out".into());
-    let tmp = dir.join(format!(".{name}.{}.tmp", std::process::id()));
-    let result = (|| {
-        let f = File::create(&tmp)?;
-        let mut w = BufWriter::with_capacity(1 << 20, f);
-        body(&mut w)?;
-        w.flush()?;
-        w.into_inner().map_err(|e| e.into_error())?.sync_all()?;
-        std::fs::rename(&tmp, path)
-    })();
-    result.map_err(|e| {
-        let _ = std::fs::remove_file(&tmp);
-        IoError::file(path, format!("cannot write: {}", open_message(&e)))
-    })
 }

@@ -2,6 +2,7 @@
 //! the ASCII readers so that every parse error can name its line.
 
 use super::IoError;
+pub(crate) use crate::file::as_text;
 use std::path::Path;
 use std::str::FromStr;
 
@@ -138,22 +139,6 @@ fn shorten(s: &str) -> String {
     } else {
         s.to_string()
     }
-}
-
-/// The file as UTF-8 text, or a clear error for binary garbage.
-pub(crate) fn as_text<'a>(path: &Path, bytes: &'a [u8]) -> Result<&'a str, IoError> {
-    std::str::from_utf8(bytes).map_err(|e| {
-        let line = bytes[..e.valid_up_to()]
-            .iter()
-            .filter(|&&c| c == b'\n')
-            .count()
-            + 1;
-        IoError::at(
-            path,
-            line,
-            "not a text file (invalid UTF-8): expected an ASCII mesh",
-        )
-    })
 }
 
 /// The records of a line-oriented text file: each non-blank line, with `#`

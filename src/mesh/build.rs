@@ -2,8 +2,9 @@
 //! adjacency by bucketing half-faces on their smallest vertex (parallel).
 
 use super::{edge_key, face_key, MeshData, TetMesh, NO_ADJ};
-use crate::geom::{orient3d_sign, Orientation, TET_FACES};
-use crate::ops::bulk::Disjoint;
+use crate::geom::{orient3d_sign, Orientation};
+use crate::topo::scatter::Disjoint;
+use crate::topo::TET_FACES;
 use glam::DVec3;
 use rayon::prelude::*;
 use std::collections::{HashMap, HashSet};
@@ -370,7 +371,7 @@ impl TetMesh {
                 .tets
                 .iter()
                 .flat_map(|v| {
-                    crate::geom::TET_EDGES
+                    crate::topo::TET_EDGES
                         .iter()
                         .map(move |e| edge_key(v[e[0]], v[e[1]]))
                 })

@@ -1,7 +1,8 @@
 //! [`TetMesh::check`]: verifies every invariant of the store.
 
 use super::{edge_key, face_key, TetMesh, DEAD, NO_ADJ};
-use crate::geom::{orient3d_sign, Orientation, TET_EDGES, TET_FACES};
+use crate::geom::{orient3d_sign, Orientation};
+use crate::topo::{TET_EDGES, TET_FACES};
 use rayon::prelude::*;
 use std::collections::{HashMap, HashSet};
 

@@ -20,14 +20,18 @@ mod compact;
 mod data;
 pub mod fasthash;
 pub mod generate;
+mod moves;
 mod reorder;
 
+/// The store's keys of sparse tags (defined once, in [`crate::topo`]).
+pub use crate::topo::{edge_key, face_key, EdgeKey, FaceKey};
 pub use build::{BuildReport, MeshError};
 pub use check::CheckError;
 pub use compact::Remap;
 pub use data::MeshData;
+pub use moves::{ball_stays_positive, tet_points_with};
 
-use crate::geom::{TET_EDGES, TET_EDGE_OPPOSITE, TET_FACES};
+use crate::topo::{TET_EDGES, TET_EDGE_OPPOSITE, TET_FACES};
 use fasthash::{FastHashMap, FastHashSet};
 use glam::DVec3;
 use rayon::prelude::*;
@@ -36,36 +40,6 @@ use rayon::prelude::*;
 pub const NO_ADJ: u32 = u32::MAX;
 /// Vertex id stored in every slot of a dead tet.
 pub const DEAD: u32 = u32::MAX;
-
-/// A face key: the three vertex ids sorted ascending.
-pub type FaceKey = [u32; 3];
-/// An edge key: the two vertex ids sorted ascending.
-pub type EdgeKey = [u32; 2];
-
-/// Sorted key of a triangle.
-#[inline]
-pub fn face_key(mut f: [u32; 3]) -> FaceKey {
-    if f[0] > f[1] {
-        f.swap(0, 1);
-    }
-    if f[1] > f[2] {
-        f.swap(1, 2);
-    }
-    if f[0] > f[1] {
-        f.swap(0, 1);
-    }
-    f
-}
-
-/// Sorted key of an edge.
-#[inline]
-pub fn edge_key(a: u32, b: u32) -> EdgeKey {
-    if a < b {
-        [a, b]
-    } else {
-        [b, a]
-    }
-}
 
 /// Per-slot marks for walks over tets (balls, cavities) without hashing: a
 /// slot is marked when its stamp equals the current epoch, so clearing is O(1).
@@ -171,7 +145,7 @@ impl TetMesh {
     }
 
     /// Moves point `v`. The caller is responsible for orientation (see
-    /// [`crate::smooth::ball_stays_positive`]).
+    /// [`ball_stays_positive`]).
     #[inline]
     pub fn set_point(&mut self, v: u32, p: DVec3) {
         self.points[v as usize] = p;

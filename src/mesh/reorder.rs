@@ -8,7 +8,7 @@
 
 use super::fasthash::{FastHashMap, FastHashSet};
 use super::{edge_key, face_key, Remap, TetMesh, DEAD, NO_ADJ};
-use crate::ops::bulk::{Disjoint, LastTouch};
+use crate::topo::scatter::{Disjoint, LastTouch};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicU32, Ordering};
 

@@ -28,10 +28,11 @@
 //! The result equals calling [`super::flip23`] on the faces in order (same
 //! slots, generations and vertex → tet entries). Seed paper §3.1 (Figure 5).
 
-use super::bulk::{Disjoint, LastTouch};
 use super::is_constrained_face;
-use crate::geom::{orient3d, TET_FACES};
+use crate::geom::all_positive;
 use crate::mesh::{TetMesh, DEAD, NO_ADJ};
+use crate::topo::scatter::{Disjoint, LastTouch};
+use crate::topo::TET_FACES;
 use glam::DVec3;
 use rayon::prelude::*;
 
@@ -96,10 +97,7 @@ impl Flip {
     #[inline]
     fn positive(self, tets: &[[u32; 4]], points: &[DVec3]) -> bool {
         let n = self.new_tets(tets[self.t as usize], tets[self.u as usize]);
-        n.iter().all(|v| {
-            let p = v.map(|x| points[x as usize]);
-            orient3d(p[0], p[1], p[2], p[3]) > 0.0
-        })
+        all_positive(n.iter().map(|v| v.map(|x| points[x as usize])))
     }
 
     /// The new half-face that outer face `m` (local index in `t` when `side`
@@ -286,12 +284,11 @@ impl FlipBatch {
                 .find(|m| m.0 == x)
                 .map_or(points[x as usize], |m| m.1)
         };
-        fl.new_tets(tets[fl.t as usize], tets[fl.u as usize])
-            .iter()
-            .all(|v| {
-                let p = v.map(at);
-                orient3d(p[0], p[1], p[2], p[3]) > 0.0
-            })
+        all_positive(
+            fl.new_tets(tets[fl.t as usize], tets[fl.u as usize])
+                .iter()
+                .map(|v| v.map(at)),
+        )
     }
 
     /// Judges flip `i` again on the current points.

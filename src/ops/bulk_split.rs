@@ -27,9 +27,9 @@
 //! (allocate by prefix sum, fill in parallel) is the usual one of bulk mesh
 //! refinement.
 
-use super::bulk::{Disjoint, LastTouch};
-use crate::geom::orient3d;
+use crate::geom::all_positive;
 use crate::mesh::{TetMesh, DEAD, NO_ADJ};
+use crate::topo::scatter::{Disjoint, LastTouch};
 use glam::DVec3;
 use rayon::prelude::*;
 
@@ -48,11 +48,11 @@ fn barycentre(points: &[DVec3], v: [u32; 4]) -> DVec3 {
 #[inline]
 fn children_positive(points: &[DVec3], v: [u32; 4], c: DVec3) -> bool {
     let p = v.map(|x| points[x as usize]);
-    (0..4).all(|j| {
+    all_positive((0..4).map(|j| {
         let mut q = p;
         q[j] = c;
-        orient3d(q[0], q[1], q[2], q[3]) > 0.0
-    })
+        q
+    }))
 }
 
 /// 1-4 splits every live tet whose slot is selected (`None`: every tet) at

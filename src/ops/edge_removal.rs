@@ -20,8 +20,9 @@
 //! paper §4: the new boundary edge joins the two face barycentres p0 and p_m.
 
 use super::{replace_cavity, OpError};
-use crate::geom::{orient3d, tet_min_sine, TET_EDGES, TET_EDGE_OPPOSITE};
+use crate::geom::{orient3d, tet_min_sine};
 use crate::mesh::{TetMesh, NO_ADJ};
+use crate::topo::{TET_EDGES, TET_EDGE_OPPOSITE};
 
 /// The tets around an edge `(a, b)` in rotational order.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]

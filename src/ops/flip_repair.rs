@@ -22,8 +22,8 @@
 //! one-by-one repair for any number of threads.
 
 use super::FlipBatch;
+use crate::mesh::ball_stays_positive;
 use crate::mesh::{TetMesh, NO_ADJ};
-use crate::smooth::ball_stays_positive;
 use glam::DVec3;
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicU32, Ordering};

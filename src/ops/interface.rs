@@ -17,8 +17,8 @@
 
 use super::edge_removal::{best_ring_triangulation, EdgeRing};
 use super::{replace_cavity_raw, OpError};
-use crate::geom::TET_FACES;
 use crate::mesh::{TetMesh, NO_ADJ};
+use crate::topo::TET_FACES;
 use glam::DVec3;
 
 /// Splits interior face `f` of tet `t` at `p`, splitting both tets in three;

@@ -7,7 +7,6 @@
 //! flat tet returns [`OpError::WouldInvert`] and leaves the mesh untouched.
 //! The shared re-linking lives here in [`replace_cavity`].
 
-pub(crate) mod bulk;
 pub mod bulk_flip;
 pub mod bulk_split;
 pub mod edge_removal;
@@ -19,8 +18,8 @@ pub mod split13;
 pub mod split14;
 pub mod trisect;
 
-use crate::geom::{orient3d, TET_FACES};
 use crate::mesh::{face_key, FaceKey, TetMesh, NO_ADJ};
+use crate::topo::TET_FACES;
 
 pub use bulk_flip::{flip23_bulk, FlipBatch};
 pub use bulk_split::split14_bulk;
@@ -50,10 +49,7 @@ pub enum OpError {
 
 /// Whether every tet in `tets` is positively oriented (exact predicate).
 pub fn all_positive(mesh: &TetMesh, tets: &[[u32; 4]]) -> bool {
-    tets.iter().all(|v| {
-        let p = v.map(|x| mesh.point(x));
-        orient3d(p[0], p[1], p[2], p[3]) > 0.0
-    })
+    crate::geom::all_positive(tets.iter().map(|v| v.map(|x| mesh.point(x))))
 }
 
 /// Whether interior face `f` of `t` must survive like the boundary: it

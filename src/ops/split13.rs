@@ -13,8 +13,8 @@
 //! Kobbelt's √3 1-3 split.
 
 use super::{replace_cavity, OpError};
-use crate::geom::TET_FACES;
 use crate::mesh::TetMesh;
+use crate::topo::TET_FACES;
 use glam::DVec3;
 
 /// Splits boundary face `f` of tet `t` at `p` (on or near the face) and

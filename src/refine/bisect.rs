@@ -31,8 +31,9 @@
 //! faces the marker, a feature edge its two halves; corners and required
 //! vertices keep their ids (old points keep theirs, midpoints come after).
 
-use crate::geom::{orient3d_sign, Orientation, TET_EDGES};
+use crate::geom::{orient3d_sign, Orientation};
 use crate::mesh::{edge_key, face_key, EdgeKey, FaceKey, TetMesh, DEAD, NO_ADJ};
+use crate::topo::TET_EDGES;
 use glam::DVec3;
 use rayon::prelude::*;
 use std::sync::OnceLock;

@@ -190,7 +190,7 @@ pub fn read_edge_list(mesh: &mut TetMesh, path: &Path) -> Result<usize, crate::i
     let mut all: std::collections::HashSet<[u32; 2]> = std::collections::HashSet::new();
     for t in mesh.tet_ids() {
         let v = mesh.tet(t);
-        for [i, j] in crate::geom::TET_EDGES {
+        for [i, j] in crate::topo::TET_EDGES {
             all.insert(edge_key(v[i], v[j]));
         }
     }

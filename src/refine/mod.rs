@@ -8,10 +8,10 @@
 //! 4. `boundary-flip` — every old boundary edge between two split faces is
 //!    removed (m tets → 2m − 2), so the new boundary edge joins two face
 //!    barycentres: the triangle √3 flip;
-//! 5. `boundary-smooth` — the √3 stencils of [`crate::surface::sqrt3`] move the
+//! 5. `boundary-smooth` — the √3 stencils of [`crate::stencil`] move the
 //!    boundary points; a move that would invert a tet is shortened or skipped;
 //! 6. `optimize` — interior edge removal and vertex smoothing
-//!    ([`crate::smooth::improve`]).
+//!    ([`crate::improve::improve`]).
 //!
 //! A step renumbers tets and points (it compacts the mesh and sorts it along
 //! a space-filling curve before `optimize`), so ids held across a step are
@@ -42,8 +42,8 @@ pub struct NoProgress;
 
 impl Progress for NoProgress {}
 
-use crate::smooth::ImproveReport;
-use crate::surface::sqrt3::Sqrt3Rule;
+use crate::improve::ImproveReport;
+pub use crate::stencil::Sqrt3Rule;
 use serde::Serialize;
 use std::fmt;
 use std::str::FromStr;
@@ -111,48 +111,12 @@ impl FromStr for Phase {
     }
 }
 
-/// The boundary rule of step 5.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
-pub enum BoundaryRule {
-    /// Labsik–Greiner interpolating √3: old boundary points stay.
-    #[default]
-    Interpolating,
-    /// Kobbelt's approximating √3.
-    Approximating,
-    /// New boundary points on the old surface (face barycentres), old ones fixed.
-    Linear,
-}
-
-impl BoundaryRule {
-    /// The shared surface stencil for this rule.
-    pub fn sqrt3_rule(self) -> Sqrt3Rule {
-        match self {
-            BoundaryRule::Interpolating => Sqrt3Rule::Interpolating,
-            BoundaryRule::Approximating => Sqrt3Rule::Approximating,
-            BoundaryRule::Linear => Sqrt3Rule::Linear,
-        }
-    }
-}
-
-impl FromStr for BoundaryRule {
-    type Err = String;
-    fn from_str(s: &str) -> Result<BoundaryRule, String> {
-        match s {
-            "interpolating" => Ok(BoundaryRule::Interpolating),
-            "approximating" => Ok(BoundaryRule::Approximating),
-            "linear" => Ok(BoundaryRule::Linear),
-            _ => Err(format!(
-                "unknown boundary rule '{s}'; one of interpolating, approximating, linear"
-            )),
-        }
-    }
-}
-
 /// Options of a refinement step.
 #[derive(Clone, Debug)]
 pub struct RefineOptions {
-    /// Boundary rule.
-    pub boundary: BoundaryRule,
+    /// Boundary rule of step 5: the √3 surface stencil the boundary points
+    /// follow.
+    pub boundary: Sqrt3Rule,
     /// Passes of the optimize phase (0 = skip it).
     pub opt_passes: usize,
     /// Quality (min sine) below which vertices are smoothed.
@@ -175,7 +139,7 @@ pub struct RefineOptions {
     /// record failures in [`StepReport::check_failures`] (tests, debugging).
     pub check_each_phase: bool,
     /// How hard the optimize phase works (`--effort`).
-    pub effort: crate::smooth::Effort,
+    pub effort: crate::improve::Effort,
     /// Hausdorff bound of boundary moves (`--hausd`; `None`: relative to the
     /// local edge length).
     pub hausd: Option<f64>,
@@ -184,7 +148,7 @@ pub struct RefineOptions {
 impl Default for RefineOptions {
     fn default() -> Self {
         RefineOptions {
-            boundary: BoundaryRule::Interpolating,
+            boundary: Sqrt3Rule::Interpolating,
             opt_passes: 3,
             threshold: 0.3,
             stop_after: None,
@@ -192,7 +156,7 @@ impl Default for RefineOptions {
             smooth_refined_only: false,
             step_offset: 0,
             check_each_phase: false,
-            effort: crate::smooth::Effort::Default,
+            effort: crate::improve::Effort::Default,
             hausd: None,
         }
     }

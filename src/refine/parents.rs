@@ -1,8 +1,9 @@
 //! The `parent` of an output tet: the input tet that holds its centroid.
 
-use crate::geom::{orient3d, TET_FACES};
+use crate::geom::orient3d;
 use crate::mesh::fasthash::FastHashSet;
 use crate::mesh::{TetMesh, NO_ADJ};
+use crate::topo::TET_FACES;
 use glam::DVec3;
 use rayon::prelude::*;
 

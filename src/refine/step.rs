@@ -1,15 +1,16 @@
 //! The phases of one √3 step (see the module docs of [`crate::refine`]).
 
 use super::{NoProgress, Phase, PhaseReport, Progress, RefineOptions, StepReport};
-use crate::geom::TET_EDGES;
+use crate::improve::{improve, ImproveOptions};
+use crate::mesh::ball_stays_positive;
 use crate::mesh::fasthash::FastHashMap;
 use crate::mesh::{edge_key, TetMarks, TetMesh};
 use crate::ops::{
     flip23_bulk, is_constrained_face, make_flips_valid, remove_edge, remove_interface_edge,
     split14_bulk, split_boundary_face, split_interface_face, trisect_edge, EdgeRing, FlipBatch,
 };
-use crate::smooth::{ball_stays_positive, improve, ImproveOptions};
-use crate::surface::sqrt3::sqrt3_positions_trisecting;
+use crate::stencil::sqrt3_positions_trisecting;
+use crate::topo::TET_EDGES;
 use glam::DVec3;
 use std::collections::HashSet;
 use std::time::Instant;
@@ -384,7 +385,7 @@ fn boundary_smooth_phase(
     let pos = sqrt3_positions_trisecting(
         mesh.points(),
         &tris,
-        opts.boundary.sqrt3_rule(),
+        opts.boundary,
         creases,
         &corners,
         &st.trisected,

@@ -19,8 +19,9 @@
 mod angles;
 mod topology;
 
-use crate::geom::{orient3d, TET_FACES};
+use crate::geom::is_positive;
 use crate::mesh::{TetMesh, DEAD, NO_ADJ};
+use crate::topo::TET_FACES;
 use angles::{cosine_extremes, lanes, BinThresholds, LaneVec, LANES};
 use glam::DVec3;
 use rayon::prelude::*;
@@ -150,8 +151,7 @@ fn is_inverted(d: f64, edge_product: f64, corners: impl FnOnce() -> [DVec3; 4]) 
     if edge_product > 1e-250 && edge_product.is_finite() && d * d > 1e-26 * edge_product {
         d < 0.0
     } else {
-        let p = corners();
-        orient3d(p[0], p[1], p[2], p[3]) <= 0.0
+        !is_positive(&corners())
     }
 }
 
@@ -517,9 +517,10 @@ fn finite_or_zero(x: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::geom::{orient3d_sign, tet_quality, Orientation, TET_EDGES};
+    use crate::geom::{orient3d_sign, tet_quality, Orientation};
     use crate::mesh::generate::cube_grid;
     use crate::mesh::{edge_key, MeshData};
+    use crate::topo::TET_EDGES;
     use std::collections::HashSet;
 
     fn xorshift(mut s: u64) -> impl FnMut() -> f64 {

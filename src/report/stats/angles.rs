@@ -18,8 +18,8 @@
 //!   and `sqrt` alone, so it is the same bits on every machine and in the
 //!   vector and scalar code.
 
-use crate::geom::TET_EDGE_OPPOSITE;
 use crate::report::stats::Histogram;
+use crate::topo::TET_EDGE_OPPOSITE;
 use std::cmp::Ordering;
 
 /// Tets whose angles are computed side by side.

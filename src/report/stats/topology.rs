@@ -26,8 +26,8 @@
 //! valence is counted exactly, by collecting the neighbours of those vertices
 //! ([`count_neighbours`]).
 
-use crate::geom::TET_FACES;
 use crate::mesh::{TetMesh, DEAD, NO_ADJ};
+use crate::topo::TET_FACES;
 use rayon::prelude::*;
 
 /// Valence of each point slot (0 for points no tet uses), given the number

@@ -1,0 +1,334 @@
+//! `tetrefine surface SCHEME IN -o OUT --steps N [options]`.
+
+use std::path::PathBuf;
+use tetrefine_surface::catmull_clark::catmull_clark;
+use tetrefine_surface::catmull_clark_weighted::{catmull_clark_weighted, WeightedConfig};
+use tetrefine_surface::doo_sabin::doo_sabin;
+use tetrefine_surface::ifs::{
+    gasket_control, ifs_attractor, koch_control, write_polylines, PolylineFormat,
+};
+use tetrefine_surface::loop_scheme::loop_subdivide;
+use tetrefine_surface::sierpinski::{sierpinski_with, SierpinskiOptions};
+use tetrefine_surface::sqrt3::{sqrt3, FaceSelection, Sqrt3Options, Sqrt3Rule};
+use tetrefine_surface::truncate::{check_cut, truncate_with};
+use tetrefine_surface::{
+    load_surface, read_surface, write_surface, Features, IfsKind, PolyMesh, SurfaceFormat,
+};
+
+/// The surface schemes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Scheme {
+    /// Kobbelt's approximating √3 (triangles).
+    Sqrt3,
+    /// Labsik–Greiner's interpolating √3 (triangles).
+    Sqrt3Interp,
+    /// √3 topology only: old points fixed, new points at centroids (triangles).
+    Sqrt3Linear,
+    /// Loop (triangles).
+    Loop,
+    /// Catmull–Clark (any polygons).
+    CatmullClark,
+    /// Doo–Sabin (any polygons; no creases).
+    DooSabin,
+    /// Hansmeyer's weighted and extruded Catmull–Clark; weights from --weights FILE.json.
+    CatmullClarkWeighted,
+    /// Sierpinski polyhedra (closed surfaces; joints as tiny tubes, see --neck).
+    Sierpinski,
+    /// Chaikin vertex truncation, every edge cut at --cut and 1 − cut (closed surfaces).
+    Truncate,
+    /// Attractor of the IFS of a subdivision scheme (--kind); writes polylines (.vtp, .csv).
+    Ifs,
+}
+
+/// The subdivision schemes whose IFS `ifs` iterates.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum IfsKindArg {
+    /// Uniform cubic B-spline curve (at least 4 control points).
+    CubicBspline,
+    /// Interpolating four-point curve (at least 6 control points).
+    FourPoint,
+    /// Bicubic B-spline patch (a --grid NU,NV of control points, row-major).
+    Bicubic,
+    /// Koch curve (5 control points; the standard ones without input).
+    Koch,
+    /// Sierpinski gasket (6 control points; the standard ones without input).
+    Gasket,
+}
+
+/// Arguments of `surface`.
+#[derive(clap::Args)]
+pub struct Args {
+    /// Subdivision scheme.
+    #[arg(value_enum)]
+    pub scheme: Scheme,
+    /// Input surface (.obj, .off, .ply); for ifs, its points are the control
+    /// points (optional for --kind koch and gasket).
+    pub input: Option<PathBuf>,
+    /// Output surface (.obj, .off, .ply, .vtp, .vtk); for ifs, polylines (.vtp, .csv).
+    #[arg(short, long)]
+    pub output: PathBuf,
+    /// Number of subdivision steps (for ifs: rounds of the maps).
+    #[arg(long, visible_alias = "iterations", default_value_t = 1)]
+    pub steps: usize,
+    /// Tag every edge whose faces meet at more than DEG degrees (normal
+    /// deviation) as a crease.
+    #[arg(long, value_name = "DEG")]
+    pub crease_angle: Option<f64>,
+    /// Tag crease edges, as 0-based vertex pairs "a-b" (comma separated or repeated).
+    #[arg(long, value_delimiter = ',', value_name = "A-B")]
+    pub crease: Vec<String>,
+    /// Tag corner vertices (0-based ids, comma separated or repeated).
+    #[arg(long, value_delimiter = ',', value_name = "V")]
+    pub corner: Vec<u32>,
+    /// √3 only: refine adaptively the triangles whose centroid is in the box
+    /// "xmin,ymin,zmin,xmax,ymax,zmax".
+    #[arg(
+        long,
+        value_delimiter = ',',
+        allow_negative_numbers = true,
+        value_name = "X0,Y0,Z0,X1,Y1,Z1"
+    )]
+    pub select_box: Option<Vec<f64>>,
+    /// √3 only: refine adaptively the triangles whose centroid is in the ball
+    /// "x,y,z,radius".
+    #[arg(
+        long,
+        value_delimiter = ',',
+        allow_negative_numbers = true,
+        value_name = "X,Y,Z,R"
+    )]
+    pub select_sphere: Option<Vec<f64>>,
+    /// catmull-clark-weighted only: the weights as a JSON file (see the README).
+    #[arg(long, value_name = "FILE.json")]
+    pub weights: Option<PathBuf>,
+    /// sierpinski only: where the tube at a joint leaves each piece, as a
+    /// fraction of the piece edges (0 < F < 0.5) [default: 0.05].
+    #[arg(long, value_name = "F")]
+    pub neck: Option<f64>,
+    /// truncate only: cut every edge at F and 1 − F of its length (0 < F < 0.5)
+    /// [default: 0.25, Chaikin].
+    #[arg(long, value_name = "F")]
+    pub cut: Option<f64>,
+    /// ifs only: the subdivision scheme.
+    #[arg(long, value_enum)]
+    pub kind: Option<IfsKindArg>,
+    /// ifs --kind bicubic only: the control grid size, "NU,NV".
+    #[arg(long, value_delimiter = ',', value_name = "NU,NV")]
+    pub grid: Option<Vec<usize>>,
+}
+
+/// Faces above which a run is refused rather than exhausting memory.
+const MAX_FACES: f64 = 2.0e8;
+
+fn parse_crease(s: &str) -> Result<[u32; 2], String> {
+    let (a, b) = s
+        .split_once('-')
+        .ok_or_else(|| format!("--crease '{s}': expected two vertex ids as A-B"))?;
+    let parse = |t: &str| {
+        t.trim()
+            .parse::<u32>()
+            .map_err(|_| format!("--crease '{s}': '{t}' is not a vertex id"))
+    };
+    Ok([parse(a)?, parse(b)?])
+}
+
+/// Checks that every option given belongs to the scheme, before any work.
+fn check_options(a: &Args, features: &Features) -> Result<(), String> {
+    let only = |given: bool, option: &str, scheme: Scheme, name: &str| {
+        if given && a.scheme != scheme {
+            Err(format!("{option} is for {name}"))
+        } else {
+            Ok(())
+        }
+    };
+    only(
+        a.weights.is_some(),
+        "--weights",
+        Scheme::CatmullClarkWeighted,
+        "catmull-clark-weighted",
+    )?;
+    only(a.neck.is_some(), "--neck", Scheme::Sierpinski, "sierpinski")?;
+    only(a.cut.is_some(), "--cut", Scheme::Truncate, "truncate")?;
+    only(a.kind.is_some(), "--kind", Scheme::Ifs, "ifs")?;
+    if a.grid.is_some() && a.kind != Some(IfsKindArg::Bicubic) {
+        return Err("--grid is for ifs --kind bicubic".into());
+    }
+    if matches!(
+        a.scheme,
+        Scheme::Sierpinski | Scheme::Truncate | Scheme::Ifs
+    ) && *features != Features::default()
+    {
+        return Err("sierpinski, truncate and ifs do not support creases or corners".into());
+    }
+    if a.scheme == Scheme::DooSabin && *features != Features::default() {
+        return Err("doo-sabin does not support creases or corners".into());
+    }
+    if let Some(neck) = a.neck {
+        SierpinskiOptions { neck }
+            .check()
+            .map_err(|e| format!("--neck: {e}"))?;
+    }
+    if let Some(cut) = a.cut {
+        check_cut(cut).map_err(|e| format!("--cut: {e}"))?;
+    }
+    if a.scheme == Scheme::Ifs {
+        if a.kind.is_none() {
+            return Err(
+                "ifs needs --kind cubic-bspline, four-point, bicubic, koch or gasket".into(),
+            );
+        }
+        if a.kind == Some(IfsKindArg::Bicubic) && a.grid.as_ref().is_none_or(|g| g.len() != 2) {
+            return Err("ifs --kind bicubic needs --grid NU,NV (the control grid size)".into());
+        }
+        if a.input.is_none() && !matches!(a.kind, Some(IfsKindArg::Koch) | Some(IfsKindArg::Gasket))
+        {
+            return Err("ifs needs an input file with the control points (optional only for --kind koch and gasket)".into());
+        }
+    } else if a.input.is_none() {
+        return Err("give the input surface (.obj, .off or .ply)".into());
+    }
+    Ok(())
+}
+
+/// `surface ifs`: the attractor as polylines.
+fn run_ifs(a: &Args) -> super::CliResult {
+    PolylineFormat::of(&a.output).map_err(|e| e.to_string())?;
+    let kind = match a.kind {
+        Some(IfsKindArg::CubicBspline) => IfsKind::CubicBSpline,
+        Some(IfsKindArg::FourPoint) => IfsKind::FourPoint,
+        Some(IfsKindArg::Bicubic) => {
+            let g = a.grid.as_deref().unwrap_or(&[]);
+            IfsKind::Bicubic {
+                nu: g.first().copied().unwrap_or(0),
+                nv: g.get(1).copied().unwrap_or(0),
+            }
+        }
+        Some(IfsKindArg::Koch) => IfsKind::Koch,
+        Some(IfsKindArg::Gasket) | None => IfsKind::Gasket,
+    };
+    let (control, source) = match &a.input {
+        Some(path) => {
+            let file = read_surface(path).map_err(|e| e.to_string())?;
+            (file.mesh.points, path.display().to_string())
+        }
+        None if kind == IfsKind::Koch => (koch_control().to_vec(), "--kind koch".to_string()),
+        None => (gasket_control().to_vec(), "--kind gasket".to_string()),
+    };
+    let lines = ifs_attractor(kind, &control, a.steps).map_err(|e| format!("{source}: {e}"))?;
+    write_polylines(&a.output, &lines).map_err(|e| e.to_string())?;
+    eprintln!(
+        "wrote {}: {} polylines, {} points",
+        a.output.display(),
+        lines.len(),
+        lines.iter().map(Vec::len).sum::<usize>()
+    );
+    Ok(())
+}
+
+/// Runs `surface`.
+pub fn run(a: Args) -> super::CliResult {
+    let features = Features {
+        creases: a
+            .crease
+            .iter()
+            .map(|s| parse_crease(s))
+            .collect::<Result<_, _>>()?,
+        corners: a.corner.clone(),
+        crease_angle: a.crease_angle,
+    };
+    check_options(&a, &features)?;
+    if a.scheme == Scheme::Ifs {
+        return run_ifs(&a);
+    }
+    SurfaceFormat::of(&a.output).map_err(|e| e.to_string())?;
+    let is_sqrt3 = matches!(
+        a.scheme,
+        Scheme::Sqrt3 | Scheme::Sqrt3Interp | Scheme::Sqrt3Linear
+    );
+    if !is_sqrt3 && (a.select_box.is_some() || a.select_sphere.is_some()) {
+        return Err("--select-box and --select-sphere are for the sqrt3 schemes".into());
+    }
+    if a.select_box.is_some() && a.select_sphere.is_some() {
+        return Err("give either --select-box or --select-sphere, not both".into());
+    }
+    if a.select_box.as_ref().is_some_and(|b| b.len() != 6) {
+        return Err("--select-box needs six numbers: xmin,ymin,zmin,xmax,ymax,zmax".into());
+    }
+    if a.select_sphere.as_ref().is_some_and(|b| b.len() != 4) {
+        return Err("--select-sphere needs four numbers: x,y,z,radius".into());
+    }
+    let weights = match &a.weights {
+        Some(p) => Some(WeightedConfig::from_json_file(p).map_err(|e| e.to_string())?),
+        None => None,
+    };
+    let input = a.input.clone().unwrap_or_default();
+    let mesh = load_surface(&input).map_err(|e| e.to_string())?;
+    let growth: f64 = if is_sqrt3 || a.scheme == Scheme::Truncate {
+        3.0
+    } else {
+        4.0
+    };
+    let sides: usize = mesh.faces.iter().map(|f| f.len()).sum();
+    let predicted = sides as f64 * growth.powi(a.steps.saturating_sub(1).min(64) as i32);
+    if predicted > MAX_FACES {
+        return Err(format!(
+            "{} steps would make about {predicted:.2e} faces; use fewer steps",
+            a.steps
+        ));
+    }
+    let ctx = |e: tetrefine_surface::SubdivisionError| format!("{}: {e}", input.display());
+    let ctx2 = |e: tetrefine_surface::SurfaceError| format!("{}: {e}", input.display());
+    let out: PolyMesh = match a.scheme {
+        Scheme::Sqrt3 | Scheme::Sqrt3Interp | Scheme::Sqrt3Linear => {
+            let rule = match a.scheme {
+                Scheme::Sqrt3 => Sqrt3Rule::Approximating,
+                Scheme::Sqrt3Interp => Sqrt3Rule::Interpolating,
+                _ => Sqrt3Rule::Linear,
+            };
+            let selection = if let Some(b) = &a.select_box {
+                FaceSelection::Box {
+                    min: glam::DVec3::new(b[0], b[1], b[2]),
+                    max: glam::DVec3::new(b[3], b[4], b[5]),
+                }
+            } else if let Some(s) = &a.select_sphere {
+                FaceSelection::Sphere {
+                    center: glam::DVec3::new(s[0], s[1], s[2]),
+                    radius: s[3],
+                }
+            } else {
+                FaceSelection::All
+            };
+            let opts = Sqrt3Options {
+                features,
+                selection,
+            };
+            sqrt3(&mesh, rule, a.steps, &opts).map_err(ctx)?
+        }
+        Scheme::Loop => loop_subdivide(&mesh, a.steps, &features).map_err(ctx)?,
+        Scheme::CatmullClark => catmull_clark(&mesh, a.steps, &features).map_err(ctx)?,
+        Scheme::DooSabin => doo_sabin(&mesh, a.steps).map_err(ctx)?,
+        Scheme::CatmullClarkWeighted => {
+            let cfg = weights.unwrap_or_default();
+            catmull_clark_weighted(&mesh, a.steps, &cfg, &features).map_err(ctx)?
+        }
+        Scheme::Sierpinski => {
+            let mut opts = SierpinskiOptions::default();
+            if let Some(neck) = a.neck {
+                opts.neck = neck;
+            }
+            sierpinski_with(&mesh, a.steps, &opts).map_err(ctx2)?
+        }
+        Scheme::Truncate => truncate_with(&mesh, a.steps, a.cut.unwrap_or(0.25)).map_err(ctx2)?,
+        Scheme::Ifs => return run_ifs(&a),
+    };
+    write_surface(&a.output, &out).map_err(|e| e.to_string())?;
+    eprintln!(
+        "wrote {}: {} vertices, {} edges, {} faces, Euler characteristic {}",
+        a.output.display(),
+        out.used_vertices(),
+        out.edge_list().len(),
+        out.faces.len(),
+        out.euler_characteristic()
+    );
+    Ok(())
+}

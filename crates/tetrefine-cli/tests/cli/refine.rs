@@ -1,0 +1,126 @@
+//! `tetrefine refine` from the command line: the per-step table, `--stats`,
+//! `--stop-after`, the `.vtu` arrays and `--features-out`.
+
+use tetrefine::io::load_mesh;
+use tetrefine::io::vtk::read_tet_cell_array;
+
+fn run(args: &[&str]) -> std::process::Output {
+    let o = crate::tetrefine_command().args(args).output().unwrap();
+    assert!(
+        o.status.success(),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    o
+}
+
+#[test]
+fn stop_after_gives_the_exact_counts_and_stats_list_every_step() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("t.mesh");
+    let stats = dir.path().join("s.json");
+    let o = run(&[
+        "refine",
+        "meshes/tripod.mesh",
+        "-o",
+        out.to_str().unwrap(),
+        "--stop-after",
+        "flip",
+        "--stats",
+        stats.to_str().unwrap(),
+    ]);
+    let table = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        table
+            .lines()
+            .any(|l| l.starts_with("input") && l.contains("2799")),
+        "{table}"
+    );
+    assert!(
+        table
+            .lines()
+            .any(|l| l.starts_with("step 1") && l.contains("15939")),
+        "{table}"
+    );
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&stats).unwrap()).unwrap();
+    let steps = v["steps"].as_array().unwrap();
+    assert_eq!(steps.len(), 2);
+    assert_eq!(steps[0]["tets"], 2799);
+    let phases = steps[1]["phases"].as_array().unwrap();
+    assert_eq!(phases.len(), 2);
+    assert_eq!(
+        (phases[0]["name"].as_str(), phases[0]["tets"].as_u64()),
+        (Some("split"), Some(11_196))
+    );
+    assert_eq!(
+        (phases[1]["name"].as_str(), phases[1]["tets"].as_u64()),
+        (Some("flip"), Some(15_939))
+    );
+    assert!(steps[1]["seconds"].as_f64().unwrap() >= 0.0);
+    assert_eq!(load_mesh(&out).unwrap().0.n_tets(), 15_939);
+}
+
+#[test]
+fn vtu_carries_level_and_parent_and_feature_lines_are_written() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("c.vtu");
+    let lines = dir.path().join("f.vtp");
+    let o = run(&[
+        "refine",
+        "meshes/mmg_cube.mesh",
+        "-o",
+        out.to_str().unwrap(),
+        "--steps",
+        "2",
+        "--boundary",
+        "linear",
+        "--features-out",
+        lines.to_str().unwrap(),
+    ]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    // mmg_cube tags its 60 ridge segments (12 cube edges) and 8 corners.
+    assert!(
+        err.contains("features: 60 edges") && err.contains("8 corners"),
+        "{err}"
+    );
+    let (m, _) = load_mesh(&out).unwrap();
+    let level = read_tet_cell_array(&out, "level").unwrap().values;
+    let parent = read_tet_cell_array(&out, "parent").unwrap().values;
+    assert_eq!(level.len(), m.n_tets());
+    assert!(level.iter().all(|&l| l == 2.0));
+    assert!(parent.iter().all(|&p| (0.0..373.0).contains(&p)));
+    // After two steps each of the 60 feature segments is trisected: 180
+    // two-point polylines.
+    let vtp = std::fs::read_to_string(&lines).unwrap();
+    let n_lines: usize = vtp
+        .split("NumberOfLines=\"")
+        .nth(1)
+        .and_then(|s| s.split('"').next())
+        .and_then(|s| s.parse().ok())
+        .unwrap();
+    assert_eq!(n_lines, 180);
+}
+
+#[test]
+fn bad_options_fail_before_any_work() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("x.vtu");
+    for args in [
+        vec!["--boundary", "cubic"],
+        vec!["--stop-after", "nonsense"],
+        vec!["--threshold", "2"],
+        vec!["--mark", "fraction:0.1"],
+        vec!["--mark", "doerfler:7", "--indicator", "x.txt"],
+        vec!["--features-out", "f.xyz"],
+        vec!["--feature-angle", "200"],
+    ] {
+        let mut all = vec!["refine", "meshes/tripod.mesh", "-o", out.to_str().unwrap()];
+        all.extend(args.iter());
+        let o = crate::tetrefine_command().args(&all).output().unwrap();
+        assert!(!o.status.success(), "{args:?} accepted");
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(!err.contains("panicked"), "{err}");
+        assert!(!out.exists(), "{args:?} left output");
+    }
+}

@@ -1,0 +1,691 @@
+//! `tetrefine surface`: each scheme end to end on a file, and bad input
+//! refused with a one-line error, a non-zero exit and no output file.
+
+use crate::shapes::*;
+use glam::DVec3;
+use std::path::Path;
+use tetrefine_surface::{load_surface, write_surface};
+
+fn run(args: &[&str]) -> (bool, String) {
+    let out = crate::tetrefine_command().args(args).output().unwrap();
+    (
+        out.status.success(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+#[test]
+fn every_scheme_writes_the_expected_counts() {
+    let dir = tempfile::tempdir().unwrap();
+    let tri = dir.path().join("ico.obj");
+    let quad = dir.path().join("cube.off");
+    write_surface(&tri, &icosahedron()).unwrap();
+    write_surface(&quad, &cube()).unwrap();
+    let weights = dir.path().join("w.json");
+    std::fs::write(&weights, r#"{"iterations": [{"face_extrude": 0.1}]}"#).unwrap();
+    // (scheme, input, steps, extra args, faces expected)
+    let cases: Vec<(&str, &Path, usize, Vec<&str>, usize)> = vec![
+        ("sqrt3", &tri, 2, vec![], 20 * 9),
+        ("sqrt3-interp", &tri, 2, vec![], 20 * 9),
+        ("sqrt3-linear", &tri, 1, vec![], 60),
+        ("loop", &tri, 2, vec![], 20 * 16),
+        ("catmull-clark", &quad, 2, vec![], 6 * 16),
+        ("doo-sabin", &quad, 1, vec![], 26),
+        (
+            "catmull-clark-weighted",
+            &quad,
+            2,
+            vec!["--weights", s(&weights)],
+            6 * 16,
+        ),
+    ];
+    for (scheme, input, steps, extra, faces) in cases {
+        for ext in ["obj", "ply"] {
+            let out = dir.path().join(format!("{scheme}.{ext}"));
+            let steps = steps.to_string();
+            let mut args = vec![
+                "surface",
+                scheme,
+                s(input),
+                "-o",
+                s(&out),
+                "--steps",
+                &steps,
+            ];
+            args.extend(extra.iter());
+            let (ok, err) = run(&args);
+            assert!(ok, "{scheme}: {err}");
+            let m = load_surface(&out).unwrap();
+            assert_eq!(m.faces.len(), faces, "{scheme}");
+            assert_eq!(m.euler_characteristic(), 2, "{scheme}");
+        }
+    }
+    // Adaptive √3 with a selection box touching part of the surface.
+    let out = dir.path().join("adaptive.vtp");
+    let (ok, err) = run(&[
+        "surface",
+        "sqrt3",
+        s(&tri),
+        "-o",
+        s(&out),
+        "--select-box",
+        "0,-5,-5,5,5,5",
+    ]);
+    assert!(ok, "{err}");
+    assert!(out.exists());
+}
+
+#[test]
+fn bad_input_fails_cleanly() {
+    let dir = tempfile::tempdir().unwrap();
+    let quad = dir.path().join("cube.obj");
+    write_surface(&quad, &cube()).unwrap();
+    let bad = dir.path().join("bad.obj");
+    std::fs::write(&bad, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3 4\n").unwrap();
+    let out = dir.path().join("out.obj");
+    let cases: Vec<(Vec<&str>, &str)> = vec![
+        (
+            vec!["surface", "loop", s(&quad), "-o", s(&out)],
+            "triangle mesh",
+        ),
+        (
+            vec!["surface", "sqrt3", s(&bad), "-o", s(&out)],
+            "bad.obj:4:",
+        ),
+        (
+            vec![
+                "surface",
+                "catmull-clark",
+                s(&quad),
+                "-o",
+                s(&out),
+                "--crease",
+                "0-7",
+            ],
+            "not an edge",
+        ),
+        (
+            vec![
+                "surface",
+                "catmull-clark",
+                s(&quad),
+                "-o",
+                s(&out),
+                "--crease",
+                "0x1",
+            ],
+            "A-B",
+        ),
+        (
+            vec![
+                "surface",
+                "doo-sabin",
+                s(&quad),
+                "-o",
+                s(&out),
+                "--corner",
+                "1",
+            ],
+            "does not support",
+        ),
+        (
+            vec![
+                "surface",
+                "loop",
+                s(&quad),
+                "-o",
+                s(&out),
+                "--weights",
+                "w.json",
+            ],
+            "--weights",
+        ),
+        (
+            vec![
+                "surface",
+                "catmull-clark",
+                s(&quad),
+                "-o",
+                s(&out),
+                "--steps",
+                "40",
+            ],
+            "fewer steps",
+        ),
+        (
+            vec!["surface", "catmull-clark", s(&quad), "-o", "out.stl"],
+            "'.stl'",
+        ),
+    ];
+    for (args, needle) in cases {
+        fails_cleanly(&args, needle, &out);
+    }
+}
+
+/// Runs `tetrefine` and asserts a clean failure: non-zero exit, one line on
+/// stderr containing `needle`, and no output file.
+fn fails_cleanly(args: &[&str], needle: &str, out: &Path) {
+    let (ok, err) = run(args);
+    assert!(!ok, "{args:?} succeeded");
+    assert!(err.contains(needle), "{args:?}: {err}");
+    assert_eq!(err.trim().lines().count(), 1, "{err}");
+    assert!(!out.exists(), "{args:?} left {}", out.display());
+}
+
+/// Topology of a polygon mesh, counted here without the crate's adjacency:
+/// every undirected edge must lie in exactly two faces that run along it in
+/// opposite directions (closed and consistently oriented); faces are joined
+/// through shared edges by union–find.
+struct ClosedTopology {
+    vertices: i64,
+    edges: i64,
+    faces: i64,
+    components: usize,
+}
+
+impl ClosedTopology {
+    fn of(m: &tetrefine_surface::PolyMesh) -> ClosedTopology {
+        use std::collections::{HashMap, HashSet};
+        let mut directed: HashMap<(u32, u32), usize> = HashMap::new();
+        for (f, face) in m.faces.iter().enumerate() {
+            for k in 0..face.len() {
+                let d = (face[k], face[(k + 1) % face.len()]);
+                assert!(directed.insert(d, f).is_none(), "directed edge {d:?} twice");
+            }
+        }
+        let mut parent: Vec<usize> = (0..m.faces.len()).collect();
+        fn root(parent: &mut [usize], mut x: usize) -> usize {
+            while parent[x] != x {
+                parent[x] = parent[parent[x]];
+                x = parent[x];
+            }
+            x
+        }
+        for (&(a, b), &f) in &directed {
+            let g = *directed
+                .get(&(b, a))
+                .unwrap_or_else(|| panic!("edge {a}->{b} has no opposite: open or misoriented"));
+            let (rf, rg) = (root(&mut parent, f), root(&mut parent, g));
+            parent[rf] = rg;
+        }
+        let components = (0..m.faces.len())
+            .filter(|&f| root(&mut parent, f) == f)
+            .count();
+        let used: HashSet<u32> = m.faces.iter().flatten().copied().collect();
+        ClosedTopology {
+            vertices: used.len() as i64,
+            edges: directed.len() as i64 / 2,
+            faces: m.faces.len() as i64,
+            components,
+        }
+    }
+
+    fn euler(&self) -> i64 {
+        self.vertices - self.edges + self.faces
+    }
+}
+
+fn tetrahedron() -> tetrefine_surface::PolyMesh {
+    tetrefine_surface::PolyMesh::new(
+        vec![
+            DVec3::new(1.0, 1.0, 1.0),
+            DVec3::new(1.0, -1.0, -1.0),
+            DVec3::new(-1.0, 1.0, -1.0),
+            DVec3::new(-1.0, -1.0, 1.0),
+        ],
+        vec![vec![0, 1, 2], vec![0, 3, 1], vec![0, 2, 3], vec![1, 3, 2]],
+    )
+}
+
+#[test]
+fn sierpinski_writes_one_closed_surface_of_the_stated_genus() {
+    let dir = tempfile::tempdir().unwrap();
+    // (name, mesh, V, E, genus after steps 1 and 2 from the paper's counts:
+    // k corner pieces joined at E midpoints give genus E − pieces + 1, then
+    // g_k = 1 − V + E(4^k + 2)/6).
+    let shapes = [
+        ("tetrahedron", tetrahedron(), 4, 6, [3, 15]),
+        ("cube", cube(), 8, 12, [5, 29]),
+        ("octahedron", octahedron(), 6, 12, [7, 31]),
+    ];
+    for (name, mesh, v, e, genus) in shapes {
+        let input = dir.path().join(format!("{name}.obj"));
+        write_surface(&input, &mesh).unwrap();
+        for k in 1..=2u32 {
+            let out = dir.path().join(format!("{name}-s{k}.obj"));
+            let steps = k.to_string();
+            let (ok, err) = run(&[
+                "surface",
+                "sierpinski",
+                s(&input),
+                "-o",
+                s(&out),
+                "--steps",
+                &steps,
+                "--neck",
+                "0.1",
+            ]);
+            assert!(ok, "{name}: {err}");
+            let t = ClosedTopology::of(&load_surface(&out).unwrap());
+            assert_eq!(t.components, 1, "{name}, {k} steps: one surface");
+            let g = 1 - t.euler() / 2;
+            assert_eq!(g, genus[k as usize - 1], "{name}, {k} steps: genus");
+            assert_eq!(g, 1 - v + e * (4i64.pow(k) + 2) / 6);
+            // Pieces, joints and apex valence sum from the construction:
+            // every joint is a tube of 3 quads with 4 vertices' worth of cuts.
+            let q = 4i64.pow(k - 1);
+            let sum = 2 * e * q;
+            let pieces = v + 2 * e * (q - 1) / 3;
+            let joints = e * (4 * q - 1) / 3;
+            assert_eq!(t.vertices, sum + pieces + 4 * joints, "{name}, {k}: V");
+            assert_eq!(t.edges, 2 * sum + 9 * joints, "{name}, {k}: E");
+            assert_eq!(t.faces, sum + pieces + 3 * joints, "{name}, {k}: F");
+        }
+    }
+}
+
+#[test]
+fn truncate_makes_every_vertex_3_valent_with_the_closed_form_counts() {
+    let dir = tempfile::tempdir().unwrap();
+    for (name, mesh) in [("cube", cube()), ("octahedron", octahedron())] {
+        let input = dir.path().join(format!("{name}.off"));
+        write_surface(&input, &mesh).unwrap();
+        let t0 = ClosedTopology::of(&mesh);
+        for k in 1..=3u32 {
+            let out = dir.path().join(format!("{name}-t{k}.ply"));
+            let steps = k.to_string();
+            let (ok, err) = run(&[
+                "surface",
+                "truncate",
+                s(&input),
+                "-o",
+                s(&out),
+                "--steps",
+                &steps,
+            ]);
+            assert!(ok, "{name}: {err}");
+            let m = load_surface(&out).unwrap();
+            let t = ClosedTopology::of(&m);
+            // E_k = 3^k E, V_k = 2·3^(k−1) E, F_k = F + V + (3^(k−1) − 1) E.
+            let p = 3i64.pow(k - 1);
+            assert_eq!(t.edges, 3 * p * t0.edges, "{name}, {k}: E");
+            assert_eq!(t.vertices, 2 * p * t0.edges, "{name}, {k}: V");
+            assert_eq!(
+                t.faces,
+                t0.faces + t0.vertices + (p - 1) * t0.edges,
+                "{name}, {k}: F"
+            );
+            let mut valence = vec![0; m.points.len()];
+            for [a, b] in m.edge_list() {
+                valence[a as usize] += 1;
+                valence[b as usize] += 1;
+            }
+            assert!(valence.iter().all(|&d| d == 3), "{name}, {k}: 3-valent");
+        }
+    }
+    // --cut 0.1: every new point lies at 1/10 or 9/10 of an input edge.
+    let input = dir.path().join("cube.off");
+    let out = dir.path().join("cube-cut.obj");
+    let (ok, err) = run(&[
+        "surface",
+        "truncate",
+        s(&input),
+        "-o",
+        s(&out),
+        "--cut",
+        "0.1",
+    ]);
+    assert!(ok, "{err}");
+    let m = load_surface(&out).unwrap();
+    let c = cube();
+    for p in &m.points {
+        let on_cut = c.edge_list().iter().any(|&[a, b]| {
+            let (pa, pb) = (c.points[a as usize], c.points[b as usize]);
+            [0.1, 0.9]
+                .iter()
+                .any(|&t| p.distance(pa + t * (pb - pa)) < 1e-12)
+        });
+        assert!(on_cut, "{p} is not a 1/10 point of a cube edge");
+    }
+}
+
+/// The polylines of a CSV written by `surface ifs`.
+fn read_polylines_csv(path: &Path) -> Vec<Vec<DVec3>> {
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut lines = text.lines();
+    assert_eq!(lines.next(), Some("polyline,point,x,y,z"));
+    let mut out: Vec<Vec<DVec3>> = Vec::new();
+    for row in lines {
+        let f: Vec<&str> = row.split(',').collect();
+        let (l, i): (usize, usize) = (f[0].parse().unwrap(), f[1].parse().unwrap());
+        if l == out.len() {
+            out.push(Vec::new());
+        }
+        assert_eq!((l + 1, i), (out.len(), out[l].len()), "rows in order");
+        let x: Vec<f64> = f[2..5].iter().map(|t| t.parse().unwrap()).collect();
+        out[l].push(DVec3::new(x[0], x[1], x[2]));
+    }
+    out
+}
+
+/// The value of `attr="N"` in the first line of a `.vtp` that has it.
+fn vtp_count(text: &str, attr: &str) -> usize {
+    let key = format!("{attr}=\"");
+    let start = text.find(&key).unwrap() + key.len();
+    let end = start + text[start..].find('"').unwrap();
+    text[start..end].parse().unwrap()
+}
+
+fn close(a: DVec3, b: DVec3) -> bool {
+    a.distance(b) < 1e-12
+}
+
+#[test]
+fn ifs_writes_koch_and_gasket_from_the_builtin_controls() {
+    let dir = tempfile::tempdir().unwrap();
+    // Koch curve: the k-th Koch polygon has 4^k segments of length 3^-k from
+    // (0,0) to (1,0).
+    let k = 4;
+    let out = dir.path().join("koch.csv");
+    let (ok, err) = run(&[
+        "surface",
+        "ifs",
+        "-o",
+        s(&out),
+        "--kind",
+        "koch",
+        "--iterations",
+        "4",
+    ]);
+    assert!(ok, "{err}");
+    let lines = read_polylines_csv(&out);
+    assert_eq!(lines.len(), 1);
+    let koch = &lines[0];
+    assert_eq!(koch.len(), 4usize.pow(k) + 1);
+    assert!(close(koch[0], DVec3::ZERO), "{}", koch[0]);
+    assert!(close(koch[koch.len() - 1], DVec3::X));
+    for w in koch.windows(2) {
+        let len = w[0].distance(w[1]);
+        assert!((len - 3f64.powi(-(k as i32))).abs() < 1e-12, "{len}");
+    }
+    // The same in .vtp: one Lines cell over 4^k + 1 points.
+    let vtp = dir.path().join("koch.vtp");
+    let (ok, err) = run(&[
+        "surface",
+        "ifs",
+        "-o",
+        s(&vtp),
+        "--kind",
+        "koch",
+        "--steps",
+        "4",
+    ]);
+    assert!(ok, "{err}");
+    let text = std::fs::read_to_string(&vtp).unwrap();
+    assert_eq!(vtp_count(&text, "NumberOfPoints"), 4usize.pow(k) + 1);
+    assert_eq!(vtp_count(&text, "NumberOfLines"), 1);
+    assert_eq!(vtp_count(&text, "NumberOfVerts"), 0);
+    // Sierpinski gasket: 3^k closed triangles of side 2^-k.
+    let out = dir.path().join("gasket.csv");
+    let (ok, err) = run(&[
+        "surface",
+        "ifs",
+        "-o",
+        s(&out),
+        "--kind",
+        "gasket",
+        "--steps",
+        "3",
+    ]);
+    assert!(ok, "{err}");
+    let tris = read_polylines_csv(&out);
+    assert_eq!(tris.len(), 27);
+    for t in &tris {
+        assert_eq!(t.len(), 4);
+        assert!(close(t[0], t[3]), "closed");
+        for w in t.windows(2) {
+            assert!((w[0].distance(w[1]) - 0.125).abs() < 1e-12);
+        }
+    }
+}
+
+#[test]
+fn ifs_curves_and_patches_from_input_control_points() {
+    let dir = tempfile::tempdir().unwrap();
+    let write_points = |name: &str, pts: &[DVec3]| {
+        let path = dir.path().join(name);
+        let text: String = pts
+            .iter()
+            .map(|p| format!("v {} {} {}\n", p.x, p.y, p.z))
+            .collect();
+        std::fs::write(&path, text).unwrap();
+        path
+    };
+    let p: Vec<DVec3> = [
+        (0.0, 0.0, 0.0),
+        (1.0, 2.0, 0.5),
+        (2.5, -1.0, 1.0),
+        (3.0, 1.5, -0.5),
+        (4.5, 0.0, 0.0),
+        (5.0, 2.0, 1.0),
+        (6.5, -0.5, 0.0),
+    ]
+    .iter()
+    .map(|&(x, y, z)| DVec3::new(x, y, z))
+    .collect();
+    // Cubic B-spline on 5 points: two uniform pieces from knot 1 to knot 3;
+    // the polyline has 2^k + 1 points, with the knot values
+    // (p_(i−1) + 4 p_i + p_(i+1))/6 at its ends and middle.
+    let spline = write_points("spline.obj", &p[..5]);
+    let out = dir.path().join("spline.csv");
+    let (ok, err) = run(&[
+        "surface",
+        "ifs",
+        s(&spline),
+        "-o",
+        s(&out),
+        "--kind",
+        "cubic-bspline",
+        "--steps",
+        "5",
+    ]);
+    assert!(ok, "{err}");
+    let line = &read_polylines_csv(&out)[0];
+    assert_eq!(line.len(), 33);
+    let knot = |i: usize| (p[i - 1] + 4.0 * p[i] + p[i + 1]) / 6.0;
+    assert!(close(line[0], knot(1)), "{} vs {}", line[0], knot(1));
+    assert!(close(line[16], knot(2)));
+    assert!(close(line[32], knot(3)));
+    // Four-point scheme on 7 points: the attractor runs from p_2 to p_4 and,
+    // the scheme being interpolating, passes through p_3 half way.
+    let four = write_points("four.obj", &p);
+    let out = dir.path().join("four.vtp");
+    let (ok, err) = run(&[
+        "surface",
+        "ifs",
+        s(&four),
+        "-o",
+        s(&out),
+        "--kind",
+        "four-point",
+        "--steps",
+        "3",
+    ]);
+    assert!(ok, "{err}");
+    let text = std::fs::read_to_string(&out).unwrap();
+    assert_eq!(vtp_count(&text, "NumberOfPoints"), 9);
+    assert_eq!(vtp_count(&text, "NumberOfLines"), 1);
+    let csv = dir.path().join("four.csv");
+    let (ok, err) = run(&[
+        "surface",
+        "ifs",
+        s(&four),
+        "-o",
+        s(&csv),
+        "--kind",
+        "four-point",
+        "--steps",
+        "3",
+    ]);
+    assert!(ok, "{err}");
+    let line = &read_polylines_csv(&csv)[0];
+    assert_eq!(line.len(), 9);
+    assert!(close(line[0], p[2]) && close(line[4], p[3]) && close(line[8], p[4]));
+    // Bicubic 4 × 4 patch: (2^k + 1) rows and as many columns of 2^k + 1
+    // points; the corner (0,0) is Σ (1,4,1)ᵢ(1,4,1)ⱼ/36 over the first 3 × 3
+    // control points.
+    let grid: Vec<DVec3> = (0..16)
+        .map(|i| {
+            let (u, v) = ((i / 4) as f64, (i % 4) as f64);
+            DVec3::new(u, v, (u * v).sin())
+        })
+        .collect();
+    let patch = write_points("patch.obj", &grid);
+    let out = dir.path().join("patch.csv");
+    let (ok, err) = run(&[
+        "surface",
+        "ifs",
+        s(&patch),
+        "-o",
+        s(&out),
+        "--kind",
+        "bicubic",
+        "--grid",
+        "4,4",
+        "--steps",
+        "2",
+    ]);
+    assert!(ok, "{err}");
+    let lines = read_polylines_csv(&out);
+    assert_eq!(lines.len(), 10);
+    assert!(lines.iter().all(|l| l.len() == 5));
+    let w = [1.0, 4.0, 1.0];
+    let corner: DVec3 = (0..3)
+        .flat_map(|a| (0..3).map(move |b| (a, b)))
+        .map(|(a, b)| grid[a * 4 + b] * w[a] * w[b] / 36.0)
+        .sum();
+    assert!(close(lines[0][0], corner), "{} vs {corner}", lines[0][0]);
+}
+
+#[test]
+fn sierpinski_truncate_and_ifs_refuse_bad_options_cleanly() {
+    let dir = tempfile::tempdir().unwrap();
+    let quad = dir.path().join("cube.obj");
+    write_surface(&quad, &cube()).unwrap();
+    let mut open_cube = cube();
+    open_cube.faces.pop();
+    let open = dir.path().join("open.obj");
+    write_surface(&open, &open_cube).unwrap();
+    let four = dir.path().join("four.obj");
+    std::fs::write(&four, "v 0 0 0\nv 1 0 0\nv 2 1 0\nv 3 0 0\n").unwrap();
+    let mesh_out = dir.path().join("out.obj");
+    let lines_out = dir.path().join("out.vtp");
+    let (m, l, q) = (s(&mesh_out), s(&lines_out), s(&quad));
+    let cases: Vec<(Vec<&str>, &str, &Path)> = vec![
+        (
+            vec!["surface", "sierpinski", q, "-o", m, "--neck", "0.5"],
+            "neck",
+            &mesh_out,
+        ),
+        (
+            vec!["surface", "truncate", q, "-o", m, "--cut", "0"],
+            "cut",
+            &mesh_out,
+        ),
+        (
+            vec!["surface", "truncate", q, "-o", m, "--neck", "0.1"],
+            "--neck is for sierpinski",
+            &mesh_out,
+        ),
+        (
+            vec!["surface", "loop", q, "-o", m, "--cut", "0.1"],
+            "--cut is for truncate",
+            &mesh_out,
+        ),
+        (
+            vec!["surface", "sierpinski", q, "-o", m, "--kind", "koch"],
+            "--kind is for ifs",
+            &mesh_out,
+        ),
+        (
+            vec!["surface", "sierpinski", q, "-o", m, "--corner", "1"],
+            "creases or corners",
+            &mesh_out,
+        ),
+        (
+            vec!["surface", "sierpinski", s(&open), "-o", m],
+            "boundary",
+            &mesh_out,
+        ),
+        (
+            vec!["surface", "truncate", s(&open), "-o", m],
+            "boundary",
+            &mesh_out,
+        ),
+        (
+            vec!["surface", "sierpinski", "-o", m],
+            "input surface",
+            &mesh_out,
+        ),
+        (
+            vec!["surface", "truncate", q, "-o", l.trim_end_matches("vtp")],
+            "extension",
+            &mesh_out,
+        ),
+        (vec!["surface", "ifs", q, "-o", l], "--kind", &lines_out),
+        (
+            vec!["surface", "ifs", "-o", l, "--kind", "cubic-bspline"],
+            "control points",
+            &lines_out,
+        ),
+        (
+            vec!["surface", "ifs", "-o", l, "--kind", "bicubic"],
+            "--grid",
+            &lines_out,
+        ),
+        (
+            vec!["surface", "ifs", "-o", l, "--kind", "koch", "--grid", "4,4"],
+            "--grid",
+            &lines_out,
+        ),
+        (
+            vec!["surface", "ifs", s(&four), "-o", l, "--kind", "koch"],
+            "exactly 5",
+            &lines_out,
+        ),
+        (
+            vec![
+                "surface",
+                "ifs",
+                s(&four),
+                "-o",
+                l,
+                "--kind",
+                "bicubic",
+                "--grid",
+                "2,2",
+            ],
+            "4 × 4",
+            &lines_out,
+        ),
+        (
+            vec![
+                "surface", "ifs", "-o", l, "--kind", "gasket", "--steps", "40",
+            ],
+            "points",
+            &lines_out,
+        ),
+        (
+            vec!["surface", "ifs", "-o", m, "--kind", "koch"],
+            ".vtp or .csv",
+            &mesh_out,
+        ),
+    ];
+    for (args, needle, out) in cases {
+        fails_cleanly(&args, needle, out);
+    }
+}

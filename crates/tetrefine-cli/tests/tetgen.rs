@@ -1,0 +1,541 @@
+//! TetGen through `tetrefine::tetgen` and `tetrefine mesh` (feature `tetgen`).
+//!
+//! Expected figures are closed forms of the input geometry, not outputs of
+//! the code under test.
+
+#![cfg(feature = "tetgen")]
+
+#[path = "../../../tests/support/mod.rs"]
+mod support;
+
+use glam::DVec3;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use tetrefine::geom::tet_volume;
+use tetrefine::io::plc::{Facet, Plc};
+use tetrefine::mesh::NO_ADJ;
+use tetrefine::tetgen::{refine, tetrahedralize, Options, TetgenError};
+use tetrefine::{MeshStats, TetMesh};
+
+const EXAMPLE: &str = "meshes/tetgen_example.poly";
+
+/// The unit cube's corners: point `i` has coordinates given by its bits.
+fn cube_points() -> Vec<[f64; 3]> {
+    (0..8)
+        .map(|i| [(i & 1) as f64, ((i >> 1) & 1) as f64, ((i >> 2) & 1) as f64])
+        .collect()
+}
+
+/// The six faces of the unit cube; face `m` gets marker `m + 1`:
+/// 1: z = 0, 2: z = 1, 3: y = 0, 4: y = 1, 5: x = 0, 6: x = 1.
+const CUBE_QUADS: [[u32; 4]; 6] = [
+    [0, 2, 3, 1],
+    [4, 5, 7, 6],
+    [0, 1, 5, 4],
+    [2, 6, 7, 3],
+    [0, 4, 6, 2],
+    [1, 3, 7, 5],
+];
+
+fn cube_plc() -> Plc {
+    Plc {
+        points: cube_points(),
+        facets: CUBE_QUADS
+            .iter()
+            .enumerate()
+            .map(|(m, q)| Facet {
+                polygons: vec![q.to_vec()],
+                holes: vec![],
+                marker: m as i32 + 1,
+            })
+            .collect(),
+        ..Default::default()
+    }
+}
+
+fn cube_triangles() -> Vec<[u32; 3]> {
+    CUBE_QUADS
+        .iter()
+        .flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]])
+        .collect()
+}
+
+fn volume(mesh: &TetMesh) -> f64 {
+    mesh.tet_ids()
+        .map(|t| tet_volume(&mesh.tet_points(t)))
+        .sum()
+}
+
+fn region_volumes(mesh: &TetMesh) -> BTreeMap<i32, f64> {
+    let mut v = BTreeMap::new();
+    for t in mesh.tet_ids() {
+        *v.entry(mesh.region(t)).or_insert(0.0) += tet_volume(&mesh.tet_points(t));
+    }
+    v
+}
+
+/// Every boundary face as (its three points, its marker).
+fn boundary_faces(mesh: &TetMesh) -> Vec<([DVec3; 3], Option<i32>)> {
+    let mut out = Vec::new();
+    for t in mesh.tet_ids() {
+        for f in 0..4 {
+            if mesh.adj(t)[f] == NO_ADJ {
+                let v = mesh.face_vertices(t, f);
+                out.push((v.map(|i| mesh.point(i)), mesh.face_marker(v)));
+            }
+        }
+    }
+    out
+}
+
+/// A good call must still work (the process survived the failing one).
+fn good_call_still_works() {
+    let mesh = tetrahedralize(&cube_plc(), &Options::default()).unwrap();
+    assert!((volume(&mesh) - 1.0).abs() < 1e-12);
+}
+
+#[test]
+fn example_poly_two_regions_exact_volume_empty_cavities() {
+    let plc = Plc::read(&support::path(EXAMPLE)).unwrap();
+    let opts = Options {
+        switches: Some("-pq1.414a0.002A".into()),
+        ..Default::default()
+    };
+    let mesh = tetrahedralize(&plc, &opts).unwrap();
+    mesh.check().unwrap();
+    assert_eq!(MeshStats::compute(&mesh).inverted, 0);
+
+    // The box [0,2]² × [0,5] cut by the plane z = 4 - y/2 (facet 2): region 10
+    // below it (mean height 3.5 over the 2 × 2 base), region 20 above; the
+    // cavity [0.25,1.75]×[0.25,1.5]×[0.5,1] and the notch
+    // [0.25,1.75]×[0,1.5]×[2,2.5] are below the plane and are holes.
+    let cavity = 1.5 * 1.25 * 0.5;
+    let notch = 1.5 * 1.5 * 0.5;
+    let r10 = 2.0 * 2.0 * 3.5 - cavity - notch;
+    let r20 = 2.0 * 2.0 * 5.0 - 2.0 * 2.0 * 3.5;
+    let total = volume(&mesh);
+    let enclosed = plc.enclosed_volume().unwrap();
+    assert!(
+        (total - enclosed).abs() < 1e-9 * enclosed,
+        "{total} vs {enclosed}"
+    );
+    assert!((total - (r10 + r20)).abs() < 1e-9 * total, "{total}");
+    let regions = region_volumes(&mesh);
+    assert_eq!(regions.keys().copied().collect::<Vec<_>>(), vec![10, 20]);
+    assert!((regions[&10] - r10).abs() < 1e-9 * r10, "{regions:?}");
+    assert!((regions[&20] - r20).abs() < 1e-9 * r20, "{regions:?}");
+
+    // No tet in the cavity or the notch.
+    let inside =
+        |p: DVec3, lo: [f64; 3], hi: [f64; 3]| (0..3).all(|a| p[a] > lo[a] && p[a] < hi[a]);
+    for t in mesh.tet_ids() {
+        let c = mesh.tet_points(t).iter().sum::<DVec3>() / 4.0;
+        assert!(
+            !inside(c, [0.25, 0.25, 0.5], [1.75, 1.5, 1.0]),
+            "tet {t} in the cavity"
+        );
+        assert!(
+            !inside(c, [0.25, 0.0, 2.0], [1.75, 1.5, 2.5]),
+            "tet {t} in the notch"
+        );
+    }
+
+    // Facet markers on the faces: the cavity's walls are marker 4, the
+    // bottom z = 0 is marker 1, the top z = 5 marker 2; the interface on
+    // z = 4 - y/2 (facet 2) keeps marker 9 although it is interior.
+    let faces = boundary_faces(&mesh);
+    assert!(
+        faces.iter().all(|(_, m)| m.is_some()),
+        "unmarked boundary face"
+    );
+    for (p, m) in &faces {
+        let c = (p[0] + p[1] + p[2]) / 3.0;
+        if c.z.abs() < 1e-12 {
+            assert_eq!(*m, Some(1));
+        } else if (c.z - 5.0).abs() < 1e-12 {
+            assert_eq!(*m, Some(2));
+        } else if inside(c, [0.2, 0.2, 0.45], [1.8, 1.55, 1.05]) {
+            assert_eq!(*m, Some(4), "cavity wall at {c}");
+        }
+    }
+    let mut interface = 0;
+    for (k, &m) in mesh.face_markers() {
+        let c = k.iter().map(|&v| mesh.point(v)).sum::<DVec3>() / 3.0;
+        let on_plane = (c.z - (4.0 - c.y / 2.0)).abs() < 1e-9;
+        if on_plane && c.x > 1e-9 && c.x < 2.0 - 1e-9 {
+            assert_eq!(m, 9, "interface face at {c}");
+            interface += 1;
+        }
+    }
+    assert!(interface > 0, "no face on the interface carries a marker");
+}
+
+#[test]
+fn cube_from_binary_stl_and_ascii_off_has_volume_one() {
+    let dir = tempfile::tempdir().unwrap();
+    let pts = cube_points();
+    let mut stl = vec![0u8; 80];
+    stl.extend_from_slice(&12u32.to_le_bytes());
+    for t in cube_triangles() {
+        stl.extend_from_slice(&[0u8; 12]);
+        for v in t {
+            for c in pts[v as usize] {
+                stl.extend_from_slice(&(c as f32).to_le_bytes());
+            }
+        }
+        stl.extend_from_slice(&[0u8; 2]);
+    }
+    let stl_path = dir.path().join("cube.stl");
+    std::fs::write(&stl_path, &stl).unwrap();
+    let mut off = String::from("OFF\n8 6 0\n");
+    for p in &pts {
+        off += &format!("{} {} {}\n", p[0], p[1], p[2]);
+    }
+    for q in CUBE_QUADS {
+        off += &format!("4 {} {} {} {}\n", q[0], q[1], q[2], q[3]);
+    }
+    let off_path = dir.path().join("cube.off");
+    std::fs::write(&off_path, off).unwrap();
+    for path in [&stl_path, &off_path] {
+        let plc = Plc::read(path).unwrap();
+        for opts in [
+            Options::default(),
+            Options {
+                min_ratio: Some(1.414),
+                max_volume: Some(0.001),
+                ..Default::default()
+            },
+        ] {
+            let mesh = tetrahedralize(&plc, &opts).unwrap();
+            mesh.check().unwrap();
+            let v = volume(&mesh);
+            assert!((v - 1.0).abs() < 1e-12, "{}: volume {v}", path.display());
+            if opts.max_volume.is_some() {
+                assert!(mesh.n_tets() >= 1000, "a0.001 needs at least 1000 tets");
+            }
+        }
+    }
+}
+
+/// The marker a face of the unit cube must carry, from its plane.
+fn cube_marker(c: DVec3) -> i32 {
+    let eps = 1e-12;
+    match () {
+        _ if c.z.abs() < eps => 1,
+        _ if (c.z - 1.0).abs() < eps => 2,
+        _ if c.y.abs() < eps => 3,
+        _ if (c.y - 1.0).abs() < eps => 4,
+        _ if c.x.abs() < eps => 5,
+        _ if (c.x - 1.0).abs() < eps => 6,
+        _ => panic!("{c} is not on the cube's boundary"),
+    }
+}
+
+#[test]
+fn cube_poly_markers_land_on_the_boundary_faces() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("cube.poly");
+    write_poly(&path, &cube_plc());
+    let plc = Plc::read(&path).unwrap();
+    let markers: Vec<i32> = plc.facets.iter().map(|f| f.marker).collect();
+    assert_eq!(markers, vec![1, 2, 3, 4, 5, 6]);
+    let mesh = tetrahedralize(
+        &plc,
+        &Options {
+            min_ratio: Some(1.5),
+            max_volume: Some(0.01),
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    mesh.check().unwrap();
+    assert!((volume(&mesh) - 1.0).abs() < 1e-12);
+    let faces = boundary_faces(&mesh);
+    let mut seen = [0usize; 7];
+    for (p, m) in &faces {
+        let c = (p[0] + p[1] + p[2]) / 3.0;
+        assert_eq!(*m, Some(cube_marker(c)), "face at {c}");
+        seen[cube_marker(c) as usize] += 1;
+    }
+    assert!(seen[1..].iter().all(|&n| n >= 2), "{seen:?}");
+    // Each cube face is covered: its boundary triangles add up to area 1.
+    let mut area = [0.0f64; 7];
+    for (p, _) in &faces {
+        let c = (p[0] + p[1] + p[2]) / 3.0;
+        area[cube_marker(c) as usize] += 0.5 * (p[1] - p[0]).cross(p[2] - p[0]).length();
+    }
+    for a in &area[1..] {
+        assert!((a - 1.0).abs() < 1e-12, "{area:?}");
+    }
+}
+
+/// Bad surfaces: the library's error must contain `needle`.
+fn bad_surfaces() -> Vec<(&'static str, Plc, &'static str)> {
+    let mut out = Vec::new();
+    // Two cubes that interpenetrate.
+    let mut two = cube_plc();
+    two.points
+        .extend(cube_points().iter().map(|p| p.map(|c| c + 0.5)));
+    for (m, q) in CUBE_QUADS.iter().enumerate() {
+        two.facets.push(Facet {
+            polygons: vec![q.iter().map(|v| v + 8).collect()],
+            holes: vec![],
+            marker: 10 + m as i32,
+        });
+    }
+    out.push(("self_intersecting", two, "intersects itself"));
+    let mut dup = cube_plc();
+    dup.facets.push(dup.facets[3].clone());
+    out.push(("duplicated", dup, "duplicates facet 4"));
+    let mut open = cube_plc();
+    open.facets.remove(1);
+    out.push(("open", open, "not closed"));
+    let mut flat = cube_plc();
+    for p in &mut flat.points {
+        p[2] = 0.5 * p[0] + 0.25 * p[1];
+    }
+    out.push(("coplanar", flat, "lie in one plane"));
+    let mut nan = cube_plc();
+    nan.points[5][0] = f64::NAN;
+    out.push(("nan", nan, "non-finite"));
+    let mut range = cube_plc();
+    range.facets[2].polygons[0][1] = 8;
+    out.push((
+        "out_of_range",
+        range,
+        "refers to point 9 but there are 8 points",
+    ));
+    out
+}
+
+#[test]
+fn bad_surfaces_are_clear_errors_and_the_process_survives() {
+    for (name, plc, needle) in bad_surfaces() {
+        let e = tetrahedralize(&plc, &Options::default()).unwrap_err();
+        assert!(matches!(e, TetgenError::Input(_)), "{name}: {e:?}");
+        let msg = e.to_string();
+        assert!(msg.contains(needle), "{name}: {msg}");
+        assert!(!msg.contains('\n'), "{name}: {msg}");
+        good_call_still_works();
+    }
+    // Options TetGen must not see.
+    for opts in [
+        Options {
+            min_ratio: Some(0.5),
+            ..Default::default()
+        },
+        Options {
+            min_dihedral: Some(75.0),
+            ..Default::default()
+        },
+        Options {
+            max_volume: Some(-1.0),
+            ..Default::default()
+        },
+        Options {
+            switches: Some("pr".into()),
+            ..Default::default()
+        },
+        Options {
+            switches: Some("po2".into()),
+            ..Default::default()
+        },
+    ] {
+        let e = tetrahedralize(&cube_plc(), &opts).unwrap_err();
+        assert!(matches!(e, TetgenError::Options(_)), "{opts:?}: {e:?}");
+        good_call_still_works();
+    }
+}
+
+#[test]
+fn refine_keeps_volume_regions_and_markers() {
+    let plc = Plc::read(&support::path(EXAMPLE)).unwrap();
+    let coarse = tetrahedralize(&plc, &Options::default()).unwrap();
+    let fine = refine(
+        &coarse,
+        &Options {
+            max_volume: Some(0.01),
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    fine.check().unwrap();
+    assert!(
+        fine.n_tets() as f64 >= 17.9 / 0.01,
+        "{} tets",
+        fine.n_tets()
+    );
+    let (a, b) = (region_volumes(&coarse), region_volumes(&fine));
+    assert_eq!(a.keys().collect::<Vec<_>>(), b.keys().collect::<Vec<_>>());
+    for (r, v) in &a {
+        assert!((b[r] - v).abs() < 1e-9 * v, "region {r}: {} vs {v}", b[r]);
+    }
+    // Bottom and top keep their markers.
+    for (p, m) in boundary_faces(&fine) {
+        let c = (p[0] + p[1] + p[2]) / 3.0;
+        if c.z.abs() < 1e-12 {
+            assert_eq!(m, Some(1));
+        } else if (c.z - 5.0).abs() < 1e-12 {
+            assert_eq!(m, Some(2));
+        }
+    }
+}
+
+#[test]
+fn refine_follows_a_size_field() {
+    let coarse = tetrahedralize(&cube_plc(), &Options::default()).unwrap();
+    // Target edge length 0.1 at every vertex: the unit cube then needs
+    // roughly 1 / (0.1³ / 6√2) ≈ 8,500 regular tets; ask for a tenth of that.
+    let sizes = vec![0.1; coarse.n_points()];
+    let fine = refine(
+        &coarse,
+        &Options {
+            size_field: Some(sizes),
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    fine.check().unwrap();
+    assert!((volume(&fine) - 1.0).abs() < 1e-12);
+    assert!(fine.n_tets() > 850, "{} tets", fine.n_tets());
+    // The same quality bound without the size field refines far less, and a
+    // coarser field gives fewer tets: the field is what drives it.
+    let quality_only = refine(
+        &coarse,
+        &Options {
+            min_ratio: Some(2.0),
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    let coarser = refine(
+        &coarse,
+        &Options {
+            size_field: Some(vec![0.2; coarse.n_points()]),
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    eprintln!(
+        "tets: quality only {}, size 0.2 {}, size 0.1 {}",
+        quality_only.n_tets(),
+        coarser.n_tets(),
+        fine.n_tets()
+    );
+    assert!(quality_only.n_tets() < coarser.n_tets());
+    assert!(coarser.n_tets() < fine.n_tets());
+    let wrong = refine(
+        &coarse,
+        &Options {
+            size_field: Some(vec![0.1; 3]),
+            ..Default::default()
+        },
+    )
+    .unwrap_err();
+    assert!(matches!(wrong, TetgenError::Options(_)), "{wrong}");
+}
+
+// ----- the command line -------------------------------------------------------
+
+fn tetrefine(args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_tetrefine"))
+        .current_dir(support::root())
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+#[test]
+fn cli_min_dihedral_18_on_the_example() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("example.mesh");
+    let o = tetrefine(&[
+        "mesh",
+        EXAMPLE,
+        "-o",
+        out.to_str().unwrap(),
+        "--min-dihedral",
+        "18",
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let (mesh, _) = tetrefine::io::load_mesh(&out).unwrap();
+    mesh.check().unwrap();
+    let s = MeshStats::compute(&mesh);
+    assert!(s.min_dihedral_deg.worst >= 18.0, "{:?}", s.min_dihedral_deg);
+    assert_eq!(s.regions.keys().collect::<Vec<_>>(), vec!["10", "20"]);
+    assert!((s.volume - 17.9375).abs() < 1e-9 * 17.9375, "{}", s.volume);
+}
+
+/// Writes `plc` as a 1-based `.poly` (markers, holes, regions).
+fn write_poly(path: &Path, plc: &Plc) {
+    let mut s = format!("{} 3 0 0\n", plc.points.len());
+    for (i, p) in plc.points.iter().enumerate() {
+        s += &format!("{} {:?} {:?} {:?}\n", i + 1, p[0], p[1], p[2]);
+    }
+    s += &format!("{} 1\n", plc.facets.len());
+    for f in &plc.facets {
+        s += &format!("{} {} {}\n", f.polygons.len(), f.holes.len(), f.marker);
+        for poly in &f.polygons {
+            s += &poly.len().to_string();
+            for v in poly {
+                s += &format!(" {}", v + 1);
+            }
+            s += "\n";
+        }
+    }
+    s += "0\n0\n";
+    std::fs::write(path, s).unwrap();
+}
+
+#[test]
+fn cli_bad_surfaces_fail_with_one_line_and_no_output() {
+    let dir = tempfile::tempdir().unwrap();
+    let good_in = dir.path().join("cube.poly");
+    write_poly(&good_in, &cube_plc());
+    for (name, plc, needle) in bad_surfaces() {
+        let input = dir.path().join(format!("{name}.poly"));
+        let output: PathBuf = dir.path().join(format!("{name}.mesh"));
+        // The reader rejects NaN and bad indices with a line number itself.
+        let text_needle = match name {
+            "nan" => "not a finite number",
+            "out_of_range" => "out of range",
+            _ => needle,
+        };
+        if name == "nan" {
+            let mut s = String::new();
+            write_poly(&input, &plc);
+            s += &std::fs::read_to_string(&input)
+                .unwrap()
+                .replace("NaN", "nan");
+            std::fs::write(&input, s).unwrap();
+        } else {
+            write_poly(&input, &plc);
+        }
+        let o = tetrefine(&[
+            "mesh",
+            input.to_str().unwrap(),
+            "-o",
+            output.to_str().unwrap(),
+        ]);
+        assert!(!o.status.success(), "{name}");
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(err.lines().count(), 1, "{name}: {err}");
+        assert!(err.starts_with("error: "), "{name}: {err}");
+        assert!(err.contains(text_needle), "{name}: {err}");
+        assert!(!output.exists(), "{name}: partial output");
+        // A good run still works.
+        let good_out = dir.path().join("cube.mesh");
+        let o = tetrefine(&[
+            "mesh",
+            good_in.to_str().unwrap(),
+            "-o",
+            good_out.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    }
+    // An output format that cannot be written is refused before meshing.
+    let o = tetrefine(&["mesh", good_in.to_str().unwrap(), "-o", "x.xyz"]);
+    assert!(!o.status.success());
+    assert_eq!(String::from_utf8_lossy(&o.stderr).lines().count(), 1);
+}

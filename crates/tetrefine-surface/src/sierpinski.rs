@@ -1,0 +1,571 @@
+//! Sierpinski polyhedra by subdivision (seed paper `000`: Akleman, Srinivasan,
+//! Chen et al., "Generalized Sierpinski polyhedra", a subdivision-inspired
+//! construction on top of Topological Mesh Modeling).
+//!
+//! One step of the paper's scheme on a closed manifold mesh: put a vertex at
+//! the midpoint of every edge, cut every corner of every face off as a
+//! triangle (old vertex, two adjacent midpoints), and remove the central face
+//! that is left. Around each old vertex `v` of valence `n` the `n` corner
+//! triangles form an open pyramid whose base is the `n`-gon of the midpoints
+//! of the edges at `v`; the paper closes it with a "back face" and joins two
+//! pyramids at every midpoint. Repeating the step on every pyramid gives a
+//! connected polyhedron of fast-growing genus whose pieces approach
+//! Sierpinski tetrahedra.
+//!
+//! ## How the joints are represented
+//!
+//! The paper joins the two pyramids that meet at a midpoint with a
+//! zero-length *self-loop* edge (an edge from the midpoint to itself, inserted
+//! with INSERTEDGE between the corners of the two central faces). Each back
+//! face then carries a self-loop at each of its corners, and the self-loop
+//! is a zero-length tube joining the two pyramids. Faces with self-loops
+//! repeat a vertex and cannot be written to `.obj`, so this module uses an
+//! equivalent manifold construction instead, a **tiny tube**:
+//!
+//! - every pyramid gets its own copy of each midpoint (the two copies at a
+//!   joint are at the same position), so the pieces are closed polyhedra that
+//!   touch at the joints;
+//! - in the written mesh, the copy in each piece is cut off at a fraction
+//!   `neck` of its three incident edges (a tiny triangular hole: the joint
+//!   vertices are always 3-valent in their piece), and the two triangular
+//!   holes are joined by a tube of three quadrilaterals.
+//!
+//! This is the connected sum the self-loop stands for, so the surface has the
+//! genus the paper's construction has. Each joint adds 4 vertices, 9 edges
+//! and 3 faces to the two touching pieces (Euler characteristic −2). Further
+//! steps act on the pieces, never on the tubes (ask for all steps in one call
+//! rather than feeding an output back in).
+//!
+//! ## Counts
+//!
+//! Let the input be a closed oriented manifold with `V` (used) vertices and
+//! `E` edges. After step `k ≥ 1`:
+//!
+//! - every piece is a pyramid (an `n`-gon base and `n` triangles); the sum of
+//!   the apex valences is `S_k = 2E·4^(k−1)` (one step turns a pyramid with
+//!   apex valence `n` into one `n`-pyramid and `n` tetrahedra: `S → 4S`);
+//! - pieces: `P_k = V + 2E(4^(k−1) − 1)/3` (`P_(k+1) = P_k + S_k`);
+//! - joints: `J_k = E(4^k − 1)/3` (`J_1 = E`, and each step keeps every joint
+//!   and adds one per piece edge, `J_(k+1) = J_k + 2S_k`);
+//! - the pieces alone have `S_k + P_k` vertices, `2S_k` edges and `S_k + P_k`
+//!   faces;
+//! - the written manifold has
+//!   `V_k = S_k + P_k + 4J_k`, `E_k = 2S_k + 9J_k`, `F_k = S_k + P_k + 3J_k`,
+//!   so `χ_k = V_k − E_k + F_k = 2P_k − 2J_k = 2V − E(4^k + 2)/3`;
+//! - for a connected input the result is connected and its genus is
+//!   `g_k = 1 − χ_k/2 = 1 − V + E(4^k + 2)/6`
+//!   (tetrahedron `4^k − 1`: 3, 15, 63, …; cube `2·4^k − 3`: 5, 29, 125, …;
+//!   octahedron `2·4^k − 1`: 7, 31, 127, …).
+//!
+//! The paper says that after the first iteration "each iteration increases
+//! the genus of the shape four times": exactly, the increase per step
+//! quadruples, `g_(k+1) − g_k = 2E·4^(k−1)`, and
+//! `g_(k+1) = 4g_k + 3(V − 1) − E`, so `g_(k+1)/g_k → 4`.
+
+use super::closed_manifold::closed_half_edges;
+use super::error::SurfaceError;
+use super::polymesh::{HalfEdges, PolyMesh, NO_TWIN};
+
+/// Options of [`sierpinski_with`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SierpinskiOptions {
+    /// Where the tube at a joint leaves each piece, as a fraction of the
+    /// piece edges at the joint (0 < neck < 0.5). Small values make the
+    /// pieces look as if they touched in a point, as in the paper.
+    pub neck: f64,
+}
+
+impl Default for SierpinskiOptions {
+    /// `neck = 0.05`.
+    fn default() -> Self {
+        SierpinskiOptions { neck: 0.05 }
+    }
+}
+
+impl SierpinskiOptions {
+    /// Checks the options: the neck lies strictly between 0 and 0.5.
+    pub fn check(&self) -> Result<(), SurfaceError> {
+        let neck = self.neck;
+        if neck > 0.0 && neck < 0.5 {
+            Ok(())
+        } else {
+            Err(SurfaceError::Parameter(format!(
+                "the Sierpinski neck must lie strictly between 0 and 0.5, got {neck}"
+            )))
+        }
+    }
+}
+
+/// `steps` Sierpinski steps (seed paper `000`) on a closed, consistently
+/// oriented manifold polygon mesh, with the default [`SierpinskiOptions`].
+///
+/// Returns one closed oriented manifold per connected component of the
+/// input, of the genus given in the [module documentation](self). `steps = 0`
+/// returns the validated input unchanged. Vertices used by no face are
+/// dropped.
+pub fn sierpinski(mesh: &PolyMesh, steps: usize) -> Result<PolyMesh, SurfaceError> {
+    sierpinski_with(mesh, steps, &SierpinskiOptions::default())
+}
+
+/// [`sierpinski`] with explicit options.
+pub fn sierpinski_with(
+    mesh: &PolyMesh,
+    steps: usize,
+    options: &SierpinskiOptions,
+) -> Result<PolyMesh, SurfaceError> {
+    options.check()?;
+    let neck = options.neck;
+    let he = closed_half_edges(mesh)?;
+    if steps == 0 {
+        return Ok(mesh.clone());
+    }
+    // Guard against counts that overflow 32-bit ids: V_k from the module docs.
+    let e = he.edges.len() as f64;
+    let v = he.vertex_out.iter().filter(|&&h| h != NO_TWIN).count() as f64;
+    let q = 4f64.powi(steps.min(64) as i32 - 1);
+    let estimate = 2.0 * e * q + (v + 2.0 * e * (q - 1.0) / 3.0) + 4.0 * e * (4.0 * q - 1.0) / 3.0;
+    if estimate > i32::MAX as f64 {
+        return Err(SurfaceError::TooLarge {
+            steps,
+            estimate,
+            what: "vertices",
+        });
+    }
+    let mut pieces = pyramids(mesh, &he, &[]);
+    for _ in 1..steps {
+        pieces = pieces.step()?;
+    }
+    pieces.with_tubes(neck)
+}
+
+/// Closed pieces that touch at joints: pairs of vertices (one in each piece)
+/// at the same position.
+struct Pieces {
+    mesh: PolyMesh,
+    joints: Vec<[u32; 2]>,
+}
+
+const NONE: u32 = u32::MAX;
+
+/// The outgoing half-edges of `v` in clockwise order (the reverse of
+/// [`HalfEdges::outgoing`]): consecutive entries `v -> u`, `v -> w` lie in the
+/// one face in which `u` precedes and `w` follows `v`.
+fn clockwise(he: &HalfEdges, v: u32) -> Vec<u32> {
+    let mut ring = he.outgoing(v);
+    ring.reverse();
+    ring
+}
+
+impl Pieces {
+    fn step(&self) -> Result<Pieces, SurfaceError> {
+        let he = closed_half_edges(&self.mesh)?;
+        Ok(pyramids(&self.mesh, &he, &self.joints))
+    }
+
+    /// The manifold: every joint becomes a tube of three quadrilaterals
+    /// between two triangular holes cut at `neck` along the joint's edges.
+    fn with_tubes(&self, neck: f64) -> Result<PolyMesh, SurfaceError> {
+        let he = closed_half_edges(&self.mesh)?;
+        let p = &self.mesh.points;
+        let nv = p.len();
+        let mut is_joint = vec![false; nv];
+        for j in &self.joints {
+            is_joint[j[0] as usize] = true;
+            is_joint[j[1] as usize] = true;
+        }
+        let mut points = Vec::new();
+        let mut new_id = vec![NONE; nv];
+        // Truncation vertex on each half-edge leaving a joint vertex.
+        let mut cut = vec![NONE; he.len()];
+        for v in 0..nv as u32 {
+            if he.vertex_out[v as usize] == NO_TWIN {
+                continue;
+            }
+            if is_joint[v as usize] {
+                let a = p[v as usize];
+                for h in he.outgoing(v) {
+                    cut[h as usize] = points.len() as u32;
+                    points.push(a + neck * (p[he.dest(h) as usize] - a));
+                }
+            } else {
+                new_id[v as usize] = points.len() as u32;
+                points.push(p[v as usize]);
+            }
+        }
+        let mut faces = Vec::with_capacity(self.mesh.faces.len() + 3 * self.joints.len());
+        for (f, face) in self.mesh.faces.iter().enumerate() {
+            let n = face.len();
+            let mut out = Vec::with_capacity(2 * n);
+            for (h, &v) in (he.face_start[f]..).zip(face) {
+                if is_joint[v as usize] {
+                    // u -> v -> w becomes u -> cut(v->u) -> cut(v->w) -> w.
+                    out.push(cut[he.twin[he.prev(h) as usize] as usize]);
+                    out.push(cut[h as usize]);
+                } else {
+                    out.push(new_id[v as usize]);
+                }
+            }
+            faces.push(out);
+        }
+        for &[a, b] in &self.joints {
+            // Rings: the face of ring[j + 1] holds cut(ring[j]) -> cut(ring[j + 1]).
+            let ta: Vec<u32> = clockwise(&he, a).iter().map(|&h| cut[h as usize]).collect();
+            let tb: Vec<u32> = clockwise(&he, b).iter().map(|&h| cut[h as usize]).collect();
+            let d = ta.len();
+            if tb.len() != d {
+                return Err(SurfaceError::Parameter(format!(
+                    "internal: joint {a}-{b} joins vertices of valence {d} and {}",
+                    tb.len()
+                )));
+            }
+            // Pair hole A (walked forwards) with hole B (walked backwards)
+            // with the rotation that makes the tube shortest.
+            let offset = (0..d)
+                .min_by(|&c1, &c2| {
+                    let len = |c: usize| -> f64 {
+                        (0..d)
+                            .map(|j| {
+                                let k = (c + d - j) % d;
+                                points[ta[j] as usize].distance_squared(points[tb[k] as usize])
+                            })
+                            .sum()
+                    };
+                    len(c1).total_cmp(&len(c2))
+                })
+                .unwrap_or(0);
+            for j in 0..d {
+                let k = (offset + d - j) % d;
+                let k1 = (offset + 2 * d - j - 1) % d;
+                faces.push(vec![ta[(j + 1) % d], ta[j], tb[k], tb[k1]]);
+            }
+        }
+        Ok(PolyMesh { points, faces })
+    }
+}
+
+/// One step: a pyramid per used vertex (apex copy, its own midpoint copies,
+/// corner triangles, back face), a joint per edge, and the old joints moved
+/// to the apex copies.
+fn pyramids(mesh: &PolyMesh, he: &HalfEdges, old_joints: &[[u32; 2]]) -> Pieces {
+    let p = &mesh.points;
+    let mut points = Vec::new();
+    let mut apex = vec![NONE; p.len()];
+    let mut mid = vec![NONE; he.len()];
+    let mut faces = Vec::new();
+    for v in 0..p.len() as u32 {
+        if he.vertex_out[v as usize] == NO_TWIN {
+            continue;
+        }
+        let ring = clockwise(he, v);
+        apex[v as usize] = points.len() as u32;
+        points.push(p[v as usize]);
+        for &h in &ring {
+            mid[h as usize] = points.len() as u32;
+            points.push(0.5 * (p[v as usize] + p[he.dest(h) as usize]));
+        }
+        // ring[j] = v -> u and ring[j + 1] = v -> w lie in the face u -> v -> w:
+        // its corner triangle is (mid(v,u), v, mid(v,w)).
+        let n = ring.len();
+        for j in 0..n {
+            faces.push(vec![
+                mid[ring[j] as usize],
+                apex[v as usize],
+                mid[ring[(j + 1) % n] as usize],
+            ]);
+        }
+        // Back face: the base of the pyramid, against the triangles.
+        faces.push(ring.iter().map(|&h| mid[h as usize]).collect());
+    }
+    let mut joints: Vec<[u32; 2]> = old_joints
+        .iter()
+        .map(|&[a, b]| [apex[a as usize], apex[b as usize]])
+        .collect();
+    for (h, &t) in (0..).zip(&he.twin) {
+        if h < t {
+            joints.push([mid[h as usize], mid[t as usize]]);
+        }
+    }
+    Pieces {
+        mesh: PolyMesh { points, faces },
+        joints,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::test_shapes::*;
+    use glam::DVec3;
+
+    /// The closed forms of the module docs, computed here from V and E only.
+    struct Predicted {
+        vertices: i64,
+        edges: i64,
+        faces: i64,
+        euler: i64,
+        genus: i64,
+    }
+
+    fn predicted(v: i64, e: i64, k: u32) -> Predicted {
+        let q = 4i64.pow(k - 1);
+        let s = 2 * e * q;
+        let pieces = v + 2 * e * (q - 1) / 3;
+        let joints = e * (4 * q - 1) / 3;
+        let vertices = s + pieces + 4 * joints;
+        let edges = 2 * s + 9 * joints;
+        let faces = s + pieces + 3 * joints;
+        let euler = vertices - edges + faces;
+        Predicted {
+            vertices,
+            edges,
+            faces,
+            euler,
+            genus: 1 - v + e * (4 * q + 2) / 6,
+        }
+    }
+
+    fn check_counts(name: &str, mesh: &PolyMesh, max_steps: u32) -> Vec<i64> {
+        let input = closed_manifold_topology(mesh).expect("input is a closed manifold");
+        let (v, e) = (input.vertices as i64, input.edges as i64);
+        let mut genera = Vec::new();
+        for k in 1..=max_steps {
+            let out = sierpinski(mesh, k as usize).expect("sierpinski");
+            let t = closed_manifold_topology(&out)
+                .unwrap_or_else(|e| panic!("{name}, {k} steps: not a closed manifold: {e}"));
+            let p = predicted(v, e, k);
+            assert_eq!(t.components, 1, "{name}, {k} steps: connected");
+            assert_eq!(t.vertices as i64, p.vertices, "{name}, {k} steps: V");
+            assert_eq!(t.edges as i64, p.edges, "{name}, {k} steps: E");
+            assert_eq!(t.faces as i64, p.faces, "{name}, {k} steps: F");
+            assert_eq!(t.euler, p.euler, "{name}, {k} steps: χ");
+            assert_eq!(t.euler, 2 * v - e * (4i64.pow(k) + 2) / 3);
+            let genus = 1 - t.euler / 2;
+            assert_eq!(genus, p.genus, "{name}, {k} steps: genus");
+            genera.push(genus);
+        }
+        genera
+    }
+
+    #[test]
+    fn tetrahedron_is_one_manifold_of_genus_4_to_the_k_minus_1() {
+        let g = check_counts("tetrahedron", &tetrahedron(), 4);
+        // Four tetrahedra joined at 6 points: genus 6 − 4 + 1 = 3; then 4^k − 1.
+        assert_eq!(g, vec![3, 15, 63, 255]);
+    }
+
+    #[test]
+    fn cube_is_one_manifold_of_predicted_genus() {
+        let g = check_counts("cube", &cube(2.0), 4);
+        // Eight corner tetrahedra joined at 12 points: genus 12 − 8 + 1 = 5.
+        assert_eq!(g, vec![5, 29, 125, 509]);
+    }
+
+    #[test]
+    fn octahedron_is_one_manifold_of_predicted_genus() {
+        let g = check_counts("octahedron", &octahedron(), 4);
+        // Six square pyramids joined at 12 points: genus 12 − 6 + 1 = 7.
+        assert_eq!(g, vec![7, 31, 127, 511]);
+    }
+
+    #[test]
+    fn torus_input_follows_the_same_formula() {
+        // The formula depends on V and E only, not on the input genus.
+        check_counts("torus", &torus(4, 3), 3);
+    }
+
+    #[test]
+    fn genus_grows_fourfold_after_the_first_step() {
+        // Paper: "After the first iteration, each iteration increases the
+        // genus of the shape four times." The increase per step quadruples,
+        // and the genus ratio tends to 4.
+        for (name, mesh, v, e) in [
+            ("tetrahedron", tetrahedron(), 4, 6),
+            ("cube", cube(1.0), 8, 12),
+            ("octahedron", octahedron(), 6, 12),
+        ] {
+            let g = check_counts(name, &mesh, 4);
+            for k in 0..2 {
+                assert_eq!(g[k + 2] - g[k + 1], 4 * (g[k + 1] - g[k]), "{name}");
+            }
+            for k in 0..3 {
+                assert_eq!(g[k + 1], 4 * g[k] + 3 * (v - 1) - e, "{name}");
+            }
+            let ratios: Vec<f64> = (0..3).map(|k| g[k + 1] as f64 / g[k] as f64).collect();
+            assert!(
+                (ratios[2] - 4.0).abs() < (ratios[1] - 4.0).abs(),
+                "{name}: {ratios:?}"
+            );
+            assert!(
+                (ratios[1] - 4.0).abs() < (ratios[0] - 4.0).abs(),
+                "{name}: {ratios:?}"
+            );
+            assert!((ratios[2] - 4.0).abs() < 0.1, "{name}: {ratios:?}");
+        }
+        // For the tetrahedron g + 1 quadruples exactly.
+        let g = check_counts("tetrahedron", &tetrahedron(), 3);
+        assert_eq!(g[1] + 1, 4 * (g[0] + 1));
+        assert_eq!(g[2] + 1, 4 * (g[1] + 1));
+    }
+
+    #[test]
+    fn written_obj_is_one_closed_surface_of_the_stated_genus() {
+        let out = sierpinski(&tetrahedron(), 2).expect("sierpinski");
+        let text = write_obj(&out);
+        let back = read_obj(&text);
+        let t = closed_manifold_topology(&back).expect("closed manifold from the .obj");
+        assert_eq!(t.components, 1);
+        assert_eq!(1 - t.euler / 2, 15);
+        // No degenerate edges: the tube vertices are distinct points.
+        let min_edge = back
+            .faces
+            .iter()
+            .flat_map(|f| (0..f.len()).map(move |i| (f[i], f[(i + 1) % f.len()])))
+            .map(|(a, b)| back.points[a as usize].distance(back.points[b as usize]))
+            .fold(f64::INFINITY, f64::min);
+        assert!(min_edge > 1e-3, "shortest edge {min_edge}");
+    }
+
+    #[test]
+    fn pieces_are_the_sierpinski_tetrahedra() {
+        // Every point lies within neck · (piece edge) of a corner of a level-k
+        // Sierpinski sub-tetrahedron (barycentric coordinates in 2^-k Z), and
+        // exactly the 4 input corners are kept unchanged.
+        let tet = tetrahedron();
+        let c = &tet.points;
+        let edge = c[0].distance(c[1]);
+        let neck = 0.01;
+        for k in 1..=3u32 {
+            let out = sierpinski_with(&tet, k as usize, &SierpinskiOptions { neck }).expect("ok");
+            let n = 1i64 << k;
+            let mut lattice = Vec::new();
+            for a in 0..=n {
+                for b in 0..=n - a {
+                    for d in 0..=n - a - b {
+                        let e = n - a - b - d;
+                        let w = [a, b, d, e].map(|x| x as f64 / n as f64);
+                        lattice.push(w[0] * c[0] + w[1] * c[1] + w[2] * c[2] + w[3] * c[3]);
+                    }
+                }
+            }
+            let tol = neck * edge / n as f64 * (1.0 + 1e-9);
+            for p in &out.points {
+                let d = lattice
+                    .iter()
+                    .map(|q| q.distance(*p))
+                    .fold(f64::INFINITY, f64::min);
+                assert!(d <= tol, "{k} steps: point {p} is {d} from the lattice");
+            }
+            let kept = out
+                .points
+                .iter()
+                .filter(|p| c.iter().any(|q| q.distance(**p) < 1e-15))
+                .count();
+            assert_eq!(kept, 4);
+        }
+    }
+
+    #[test]
+    fn faces_point_outwards_and_enclose_the_sierpinski_volume() {
+        // Tetrahedron: 4 half-size copies per step, volume × 1/2 per step.
+        // Cube: the first step keeps 8 corner tetrahedra of volume (s/2)^3/6,
+        // then every piece is a tetrahedron. The tubes and the cut-off tips
+        // change the volume by O(neck^3) per joint.
+        let neck = 1e-3;
+        let opts = SierpinskiOptions { neck };
+        let tet = tetrahedron();
+        let v0 = signed_volume(&tet);
+        assert!((v0 - 8.0 / 3.0).abs() < 1e-12);
+        for k in 1..=3 {
+            let v = signed_volume(&sierpinski_with(&tet, k, &opts).expect("ok"));
+            let want = v0 / 2f64.powi(k as i32);
+            assert!(
+                (v - want).abs() < 1e-6 * v0,
+                "tet, {k} steps: {v} vs {want}"
+            );
+        }
+        let side = 2.0;
+        let cube = cube(side);
+        for k in 1..=3 {
+            let v = signed_volume(&sierpinski_with(&cube, k, &opts).expect("ok"));
+            let want = 8.0 * (side / 2.0).powi(3) / 6.0 / 2f64.powi(k as i32 - 1);
+            assert!(
+                (v - want).abs() < 1e-6 * side.powi(3),
+                "cube, {k} steps: {v} vs {want}"
+            );
+        }
+    }
+
+    #[test]
+    fn topology_does_not_depend_on_the_neck() {
+        for neck in [1e-6, 0.05, 0.45] {
+            let out = sierpinski_with(&cube(1.0), 2, &SierpinskiOptions { neck }).expect("ok");
+            let t = closed_manifold_topology(&out).expect("manifold");
+            assert_eq!((t.components, 1 - t.euler / 2), (1, 29));
+        }
+    }
+
+    #[test]
+    fn zero_steps_returns_the_input() {
+        let c = cube(1.0);
+        assert_eq!(sierpinski(&c, 0).expect("ok"), c);
+    }
+
+    #[test]
+    fn bad_input_is_refused_with_a_reason() {
+        let mut open = cube(1.0);
+        open.faces.pop();
+        assert!(matches!(
+            sierpinski(&open, 1),
+            Err(SurfaceError::OpenEdge { .. })
+        ));
+        let mut flipped = cube(1.0);
+        flipped.faces[0].reverse();
+        assert!(matches!(
+            sierpinski(&flipped, 1),
+            Err(SurfaceError::EdgeOrientation { .. })
+        ));
+        let mut bad = cube(1.0);
+        bad.faces[1][0] = 99;
+        let err = sierpinski(&bad, 1).unwrap_err();
+        assert_eq!(
+            err.to_string(),
+            "face 1 refers to vertex 99, but the mesh has 8 vertices"
+        );
+        let mut nan = cube(1.0);
+        nan.points[3] = DVec3::NAN;
+        assert!(matches!(
+            sierpinski(&nan, 1),
+            Err(SurfaceError::NonFinite { vertex: 3 })
+        ));
+        for neck in [0.0, 0.5, f64::NAN] {
+            assert!(matches!(
+                sierpinski_with(&cube(1.0), 1, &SierpinskiOptions { neck }),
+                Err(SurfaceError::Parameter(_))
+            ));
+        }
+        assert!(matches!(
+            sierpinski(&cube(1.0), 40),
+            Err(SurfaceError::TooLarge { .. })
+        ));
+        // Two cubes sharing one corner: a pinched, non-manifold vertex.
+        let a = cube(1.0);
+        let mut b = cube(1.0);
+        for p in &mut b.points {
+            *p = -*p;
+        }
+        let mut pinched = a.clone();
+        let shift = pinched.points.len() as u32;
+        pinched.points.extend(b.points.iter().skip(1));
+        for f in &b.faces {
+            pinched.faces.push(
+                f.iter()
+                    .map(|&v| if v == 0 { 0 } else { v + shift - 1 })
+                    .collect(),
+            );
+        }
+        assert!(matches!(
+            sierpinski(&pinched, 1),
+            Err(SurfaceError::NonManifoldVertex { vertex: 0 })
+        ));
+    }
+}

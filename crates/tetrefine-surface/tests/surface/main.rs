@@ -1,0 +1,13 @@
+//! The surface schemes' integration tests, one binary.
+
+#[path = "../../../../tests/support/mod.rs"]
+mod support;
+
+mod shapes;
+
+mod io;
+mod polymesh;
+mod schemes;
+mod sqrt3;
+mod tet_boundary;
+mod weighted;

@@ -1,0 +1,188 @@
+//! Mesh improvement: vertex smoothing (Laplacian, then optimization-based) and
+//! interior edge removal, as in §3.2 of the seed paper.
+//!
+//! The objective everywhere is the paper's quality: the minimum signed sine of
+//! the dihedral angles of a tet, and for a vertex the minimum over its ball.
+
+pub mod boundary_smooth;
+pub mod colour;
+pub mod effort;
+pub mod laplacian;
+pub mod optimize;
+pub mod passes;
+pub mod ring;
+
+pub use effort::Effort;
+pub use passes::{fixed_vertices, improve, ImproveOptions, ImproveReport};
+
+use crate::geom::{all_positive, tet_min_sine};
+use crate::mesh::{tet_points_with, TetMesh};
+use glam::DVec3;
+use std::cell::RefCell;
+
+/// Smallest quality over the tets of `ball` if vertex `v` stood at `x`.
+pub fn ball_quality_at(mesh: &TetMesh, v: u32, ball: &[u32], x: DVec3) -> f64 {
+    let mut q = f64::INFINITY;
+    for &t in ball {
+        let p = tet_points_with(mesh, t, v, x);
+        q = q.min(tet_min_sine(&p));
+    }
+    q
+}
+
+/// Smallest and mean quality over the tets of `ball` if vertex `v` stood at `x`.
+pub fn ball_min_mean_at(mesh: &TetMesh, v: u32, ball: &[u32], x: DVec3) -> (f64, f64) {
+    let mut q = f64::INFINITY;
+    let mut sum = 0.0;
+    for &t in ball {
+        let p = tet_points_with(mesh, t, v, x);
+        let s = tet_min_sine(&p);
+        q = q.min(s);
+        sum += s;
+    }
+    (q, sum / ball.len().max(1) as f64)
+}
+
+/// Smallest quality over the tets of `ball` as they stand.
+pub fn ball_quality(mesh: &TetMesh, ball: &[u32]) -> f64 {
+    ball.iter()
+        .map(|&t| tet_min_sine(&mesh.tet_points(t)))
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// Runs `f` on this thread's "seen in this call" stamps, one per point of a
+/// mesh of `n_points` points, with a fresh epoch: a point is seen when its
+/// stamp equals the epoch, and only `v` is seen at the start. A ball has
+/// about fifteen neighbours among seventy corner entries; a stamp lookup
+/// costs fewer instructions than scanning the list found so far.
+fn with_stamps<R>(n_points: usize, v: u32, f: impl FnOnce(&mut [u32], u32) -> R) -> R {
+    thread_local! {
+        static SEEN: RefCell<(Vec<u32>, u32)> = const { RefCell::new((Vec::new(), 0)) };
+    }
+    SEEN.with(|seen| {
+        let (stamp, epoch) = &mut *seen.borrow_mut();
+        if stamp.len() < n_points {
+            stamp.resize(n_points, 0);
+        }
+        *epoch = epoch.wrapping_add(1);
+        if *epoch == 0 {
+            stamp.iter_mut().for_each(|s| *s = 0);
+            *epoch = 1;
+        }
+        stamp[v as usize] = *epoch;
+        f(stamp, *epoch)
+    })
+}
+
+/// The corners of every tet of a vertex's ball, loaded once, so that the
+/// ball's qualities with the vertex at trial positions need no lookups in the
+/// mesh. Each evaluation computes exactly what [`tet_points_with`] followed by
+/// [`tet_min_sine`] (or [`orient3d`]) computes.
+#[derive(Clone, Debug, Default)]
+pub struct BallPoints {
+    /// Corners of each ball tet, as stored in the mesh.
+    pts: Vec<[DVec3; 4]>,
+    /// Position of the vertex among each tet's corners (4: not a corner).
+    at: Vec<u8>,
+    /// Vertex ids of each ball tet, as stored in the mesh.
+    ids: Vec<[u32; 4]>,
+}
+
+impl BallPoints {
+    /// Loads the corners of the tets of `ball`, the ball of `v`.
+    pub fn load(&mut self, mesh: &TetMesh, v: u32, ball: &[u32]) {
+        self.pts.clear();
+        self.at.clear();
+        self.ids.clear();
+        for &t in ball {
+            let tv = mesh.tet(t);
+            self.ids.push(tv);
+            self.pts.push(mesh.tet_points(t));
+            self.at
+                .push(tv.iter().position(|&u| u == v).map_or(4, |i| i as u8));
+        }
+    }
+
+    /// The centroid of the distinct neighbours of `v` (the ball's vertex,
+    /// in a mesh of `n_points` points), summed in the order they first
+    /// appear in the ball: the Laplacian target. `None` for an empty ball.
+    /// Reads only what [`BallPoints::load`] loaded, so the ball is not walked
+    /// a second time in the mesh.
+    pub fn neighbour_centroid(&self, n_points: usize, v: u32) -> Option<DVec3> {
+        with_stamps(n_points, v, |stamp, epoch| {
+            let mut sum = DVec3::ZERO;
+            let mut n = 0usize;
+            for (ids, pts) in self.ids.iter().zip(&self.pts) {
+                for (&x, &p) in ids.iter().zip(pts) {
+                    let s = &mut stamp[x as usize];
+                    if *s != epoch {
+                        *s = epoch;
+                        sum += p;
+                        n += 1;
+                    }
+                }
+            }
+            (n > 0).then(|| sum / n as f64)
+        })
+    }
+
+    /// Number of tets.
+    pub fn len(&self) -> usize {
+        self.pts.len()
+    }
+
+    /// Whether the ball is empty.
+    pub fn is_empty(&self) -> bool {
+        self.pts.is_empty()
+    }
+
+    /// Corners of tet `i` of the ball with the vertex at `x`.
+    #[inline]
+    pub fn tet_with(&self, i: usize, x: DVec3) -> [DVec3; 4] {
+        let mut p = self.pts[i];
+        if let Some(c) = p.get_mut(self.at[i] as usize) {
+            *c = x;
+        }
+        p
+    }
+
+    /// The other corners of tet `i` (those that are not the vertex), in order.
+    pub fn others(&self, i: usize) -> impl Iterator<Item = DVec3> + '_ {
+        let a = self.at[i] as usize;
+        self.pts[i]
+            .iter()
+            .enumerate()
+            .filter(move |&(k, _)| k != a)
+            .map(|(_, &p)| p)
+    }
+
+    /// Quality of tet `i` with the vertex at `x`.
+    #[inline]
+    pub fn quality(&self, i: usize, x: DVec3) -> f64 {
+        tet_min_sine(&self.tet_with(i, x))
+    }
+
+    /// The ball's qualities with the vertex at `x`, into `out` (cleared
+    /// first), if every one is above `bar` (a NaN quality counts as above,
+    /// as `f64::min` ignores it); `None` at the first that is not.
+    /// On success returns the smallest (NaN ignored).
+    pub fn qualities_above(&self, x: DVec3, bar: f64, out: &mut Vec<f64>) -> Option<f64> {
+        out.clear();
+        let mut q = f64::INFINITY;
+        for i in 0..self.pts.len() {
+            let s = self.quality(i, x);
+            if s <= bar {
+                return None;
+            }
+            q = q.min(s);
+            out.push(s);
+        }
+        Some(q)
+    }
+
+    /// Whether every tet stays positively oriented (exact predicate) with the
+    /// vertex at `x`.
+    pub fn stays_positive(&self, x: DVec3) -> bool {
+        all_positive((0..self.pts.len()).map(|i| self.tet_with(i, x)))
+    }
+}

@@ -1,0 +1,322 @@
+//! Sharp features and material regions survive refinement (issue: features).
+//!
+//! Independent figures: volumes of the input, planes of the input's boundary
+//! faces, positions of the input's corners and feature segments, and the
+//! feature count of an independent script on the tripod (294 edges at a
+//! 67–71° normal deviation; DESIGN/issue text).
+
+use glam::DVec3;
+use std::collections::{BTreeMap, HashSet};
+use std::path::Path;
+use tetrefine::geom::{orient3d, tet_volume};
+use tetrefine::io::load_mesh;
+use tetrefine::mesh::generate::cube_grid;
+use tetrefine::mesh::{MeshData, TetMesh, NO_ADJ};
+use tetrefine::refine::features::detect_features;
+use tetrefine::refine::{locate_parents, refine_step, RefineOptions, Sqrt3Rule};
+
+fn load(name: &str) -> TetMesh {
+    load_mesh(&Path::new("meshes").join(name)).unwrap().0
+}
+
+/// An L-shaped block (the unit cube without the quarter x, y > 1/2) in two
+/// regions (z below / above 1/2).
+fn l_block() -> TetMesh {
+    let g = cube_grid(4);
+    let centroid = |t: &[u32; 4]| {
+        t.iter()
+            .map(|&v| DVec3::from_array(g.points[v as usize]))
+            .sum::<DVec3>()
+            / 4.0
+    };
+    let tets: Vec<[u32; 4]> = g
+        .tets
+        .iter()
+        .copied()
+        .filter(|t| {
+            let c = centroid(t);
+            !(c.x > 0.5 && c.y > 0.5)
+        })
+        .collect();
+    let regions = tets
+        .iter()
+        .map(|t| if centroid(t).z < 0.5 { 1 } else { 2 })
+        .collect();
+    let data = MeshData {
+        points: g.points.clone(),
+        tets,
+        tet_regions: regions,
+        ..Default::default()
+    };
+    let (mut m, _) = TetMesh::from_data(&data).unwrap();
+    m.compact();
+    m
+}
+
+fn region_volumes(m: &TetMesh) -> BTreeMap<i32, f64> {
+    let mut v = BTreeMap::new();
+    for t in m.tet_ids() {
+        *v.entry(m.region(t)).or_insert(0.0) += tet_volume(&m.tet_points(t));
+    }
+    v
+}
+
+fn boundary_faces(m: &TetMesh) -> Vec<[DVec3; 3]> {
+    m.tet_ids()
+        .flat_map(|t| {
+            (0..4)
+                .filter(move |&f| m.is_boundary_face(t, f))
+                .map(move |f| (t, f))
+        })
+        .map(|(t, f)| m.face_vertices(t, f).map(|v| m.point(v)))
+        .collect()
+}
+
+/// Distinct planes (unit normal, offset) of the boundary faces.
+fn planes(m: &TetMesh) -> Vec<(DVec3, f64)> {
+    let mut out: Vec<(DVec3, f64)> = Vec::new();
+    for f in boundary_faces(m) {
+        let n = (f[1] - f[0]).cross(f[2] - f[0]).normalize();
+        let d = n.dot(f[0]);
+        if !out
+            .iter()
+            .any(|(m, e)| (*m - n).length() < 1e-9 && (e - d).abs() < 1e-9)
+        {
+            out.push((n, d));
+        }
+    }
+    out
+}
+
+fn bits(p: DVec3) -> [u64; 3] {
+    [p.x.to_bits(), p.y.to_bits(), p.z.to_bits()]
+}
+
+fn feature_segments(m: &TetMesh) -> Vec<[DVec3; 2]> {
+    m.feature_edges()
+        .keys()
+        .map(|e| [m.point(e[0]), m.point(e[1])])
+        .collect()
+}
+
+fn two_steps(m: &mut TetMesh, rule: Sqrt3Rule) {
+    let opts = RefineOptions {
+        boundary: rule,
+        check_each_phase: true,
+        ..Default::default()
+    };
+    for step in 1..=2 {
+        let r = refine_step(m, step, &opts);
+        assert!(r.check_failures.is_empty(), "{:?}", r.check_failures);
+    }
+}
+
+#[test]
+fn piecewise_planar_domains_keep_volumes_planes_and_corners() {
+    let cases: Vec<(&str, TetMesh)> = vec![
+        ("mmg_cube", load("mmg_cube.mesh")),
+        ("tetgen_example", load("tetgen_example.mesh")),
+        ("l_block", l_block()),
+    ];
+    for (name, input) in cases {
+        for rule in [Sqrt3Rule::Linear, Sqrt3Rule::Interpolating] {
+            let mut m = input.clone();
+            detect_features(&mut m, 45.0);
+            let corners: Vec<DVec3> = m.corners().iter().map(|&v| m.point(v)).collect();
+            assert!(!corners.is_empty(), "{name}");
+            let vol0 = region_volumes(&m);
+            let planes0 = planes(&m);
+            let diag = {
+                let b = m
+                    .points()
+                    .iter()
+                    .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), p| {
+                        (lo.min(*p), hi.max(*p))
+                    });
+                (b.1 - b.0).length()
+            };
+            two_steps(&mut m, rule);
+            let vol = region_volumes(&m);
+            assert_eq!(
+                vol.keys().collect::<Vec<_>>(),
+                vol0.keys().collect::<Vec<_>>(),
+                "{name}"
+            );
+            let (t0, t1): (f64, f64) = (vol0.values().sum(), vol.values().sum());
+            assert!(
+                (t1 - t0).abs() <= 1e-9 * t0,
+                "{name} {rule:?}: volume {t0} -> {t1}"
+            );
+            for (r, v0) in &vol0 {
+                assert!(
+                    (vol[r] - v0).abs() <= 1e-9 * v0,
+                    "{name} {rule:?} region {r}: {v0} -> {}",
+                    vol[r]
+                );
+            }
+            // Every output boundary face lies in one input facet plane.
+            for f in boundary_faces(&m) {
+                let on = planes0
+                    .iter()
+                    .any(|(n, d)| f.iter().all(|p| (n.dot(*p) - d).abs() <= 1e-9 * diag));
+                assert!(
+                    on,
+                    "{name} {rule:?}: boundary face {f:?} left the input planes"
+                );
+            }
+            let out: HashSet<[u64; 3]> = m.points().iter().map(|&p| bits(p)).collect();
+            for c in &corners {
+                assert!(out.contains(&bits(*c)), "{name} {rule:?}: corner {c} moved");
+            }
+        }
+    }
+}
+
+#[test]
+fn feature_edges_are_kept_in_step_1_and_trisected_in_step_2() {
+    for (name, input) in [("mmg_cube", load("mmg_cube.mesh")), ("l_block", l_block())] {
+        let mut m = input.clone();
+        detect_features(&mut m, 45.0);
+        let segs0 = feature_segments(&m);
+        let key = |s: &[DVec3; 2]| {
+            let (a, b) = (bits(s[0]), bits(s[1]));
+            if a < b {
+                (a, b)
+            } else {
+                (b, a)
+            }
+        };
+        let set0: HashSet<_> = segs0.iter().map(key).collect();
+        let opts = RefineOptions {
+            boundary: Sqrt3Rule::Linear,
+            ..Default::default()
+        };
+        refine_step(&mut m, 1, &opts);
+        let set1: HashSet<_> = feature_segments(&m).iter().map(key).collect();
+        assert_eq!(
+            set1, set0,
+            "{name}: step 1 must keep the feature edges as they are"
+        );
+        refine_step(&mut m, 2, &opts);
+        let segs2 = feature_segments(&m);
+        assert_eq!(segs2.len(), 3 * segs0.len(), "{name}");
+        // Each output piece lies on one input segment and is a third of it;
+        // each input segment carries exactly three pieces.
+        let mut pieces = vec![0usize; segs0.len()];
+        for s in &segs2 {
+            let i = segs0
+                .iter()
+                .position(|[a, b]| {
+                    let ab = *b - *a;
+                    let l = ab.length();
+                    s.iter().all(|p| {
+                        let t = (*p - *a).dot(ab) / (l * l);
+                        (-1e-12..=1.0 + 1e-12).contains(&t)
+                            && (*p - (*a + ab * t)).length() <= 1e-12 * l
+                    }) && ((s[1] - s[0]).length() - l / 3.0).abs() <= 1e-12 * l
+                })
+                .unwrap_or_else(|| panic!("{name}: feature piece {s:?} is on no input segment"));
+            pieces[i] += 1;
+        }
+        assert!(pieces.iter().all(|&n| n == 3), "{name}: {pieces:?}");
+    }
+}
+
+/// Area of the faces between each pair of regions.
+fn interface_areas(m: &TetMesh) -> BTreeMap<(i32, i32), f64> {
+    let mut out = BTreeMap::new();
+    for t in m.tet_ids() {
+        for (f, &h) in m.adj(t).iter().enumerate() {
+            if h == NO_ADJ {
+                continue;
+            }
+            let (r0, r1) = (m.region(t), m.region(h >> 2));
+            if r0 < r1 {
+                let p = m.face_vertices(t, f).map(|v| m.point(v));
+                *out.entry((r0, r1)).or_insert(0.0) +=
+                    0.5 * (p[1] - p[0]).cross(p[2] - p[0]).length();
+            }
+        }
+    }
+    out
+}
+
+#[test]
+fn multi_region_meshes_keep_every_region() {
+    for name in ["gmsh_t16.mesh", "mmg_tinyBoxt.mesh", "tetgen_example.mesh"] {
+        let mut input = load(name);
+        detect_features(&mut input, 45.0);
+        let vol0 = region_volumes(&input);
+        let area0 = interface_areas(&input);
+        assert!(vol0.len() >= 2 && !area0.is_empty(), "{name}");
+        let mut m = input.clone();
+        two_steps(&mut m, Sqrt3Rule::Linear);
+        let vol = region_volumes(&m);
+        for (r, v0) in &vol0 {
+            assert!((vol[r] - v0).abs() <= 1e-9 * v0, "{name} region {r}");
+        }
+        // A flipped two-region face would move area between interfaces.
+        let area = interface_areas(&m);
+        assert_eq!(
+            area.keys().collect::<Vec<_>>(),
+            area0.keys().collect::<Vec<_>>(),
+            "{name}"
+        );
+        for (k, a0) in &area0 {
+            assert!(
+                (area[k] - a0).abs() <= 1e-9 * a0,
+                "{name} interface {k:?}: {a0} -> {}",
+                area[k]
+            );
+        }
+        // Each output tet's centroid lies in an input tet of its own region.
+        locate_parents(&input, &mut m);
+        for t in m.tet_ids() {
+            let p = m.tet_points(t);
+            let c = (p[0] + p[1] + p[2] + p[3]) / 4.0;
+            let parent = m.parent(t);
+            let q = input.tet_points(parent);
+            let inside = [[1, 2, 3], [0, 3, 2], [0, 1, 3], [0, 2, 1]]
+                .iter()
+                .all(|l| orient3d(q[l[0]], q[l[1]], q[l[2]], c) <= 0.0);
+            assert!(
+                inside,
+                "{name}: centroid of tet {t} not inside any input tet"
+            );
+            assert_eq!(input.region(parent), m.region(t), "{name}: tet {t}");
+        }
+        // The per-region tet counts are reported.
+        let s = tetrefine::MeshStats::compute(&m);
+        assert_eq!(s.regions.len(), vol0.len());
+        assert_eq!(s.regions.values().sum::<usize>(), s.tets);
+    }
+}
+
+#[test]
+fn tripod_features_match_the_independent_count_and_stay_put() {
+    for angle in [67.0, 69.0, 71.0] {
+        let mut m = load("tripod.mesh");
+        let r = detect_features(&mut m, angle);
+        assert_eq!(r.feature_edges, 294, "at {angle}°: {r:?}");
+    }
+    let mut m = load("tripod.mesh");
+    detect_features(&mut m, 69.0);
+    let on_feature: Vec<DVec3> = {
+        let mut v: Vec<u32> = m.feature_edges().keys().flatten().copied().collect();
+        v.sort_unstable();
+        v.dedup();
+        v.iter().map(|&x| m.point(x)).collect()
+    };
+    two_steps(&mut m, Sqrt3Rule::Interpolating);
+    let mut feature_points: HashSet<[u64; 3]> = HashSet::new();
+    for e in m.feature_edges().keys() {
+        feature_points.insert(bits(m.point(e[0])));
+        feature_points.insert(bits(m.point(e[1])));
+    }
+    for p in on_feature {
+        assert!(
+            feature_points.contains(&bits(p)),
+            "feature vertex {p} left its feature"
+        );
+    }
+}

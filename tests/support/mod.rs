@@ -1,0 +1,28 @@
+//! Test support shared by every test binary of the workspace (each includes
+//! it with `#[path]`): where the repository's files are, one seeded random
+//! generator, a hand-built tet grid, and a numbering-free form of a mesh.
+
+// Each test binary uses its own part of the support.
+#![allow(dead_code, unused_imports)]
+
+mod canon;
+mod grid;
+
+pub use canon::*;
+pub use grid::*;
+
+use std::path::{Path, PathBuf};
+
+/// The repository's root (the folder holding `meshes/`), whichever crate of
+/// the workspace the test belongs to.
+pub fn root() -> &'static Path {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .ancestors()
+        .find(|d| d.join("meshes").is_dir())
+        .expect("every crate of the workspace sits below the repository root, which holds meshes/")
+}
+
+/// A file of the repository, given relative to its root (`meshes/…`, `tests/…`).
+pub fn path(rel: &str) -> PathBuf {
+    root().join(rel)
+}
