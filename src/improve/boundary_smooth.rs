@@ -69,6 +69,9 @@ impl Default for BoundarySmoothOptions {
     }
 }
 
+/// A decided move: vertex, position, ball, the ball's new qualities.
+type Decided = (u32, DVec3, Vec<u32>, Vec<f64>);
+
 /// Below this worst min-sine a boundary move may lower its ball's mean.
 const SLIVER: f64 = 0.2;
 
@@ -568,7 +571,7 @@ impl BoundarySmoother {
         let qs0: Vec<f64> = (0..bp.len()).map(|i| bp.quality(i, x0)).collect();
         let q0 = qs0.iter().copied().fold(f64::INFINITY, f64::min);
         let m0 = qs0.iter().sum::<f64>() / qs0.len() as f64;
-        if !(q0 < self.opts.laplacian_threshold.max(self.opts.threshold)) {
+        if q0.is_nan() || q0 >= self.opts.laplacian_threshold.max(self.opts.threshold) {
             return None;
         }
         let mut set = Vec::new();
@@ -760,7 +763,7 @@ impl BoundarySmoother {
         let mut changed = Vec::new();
         for class in super::colour::colour_classes(mesh, verts) {
             let m = &*mesh;
-            let moves: Vec<Option<(u32, DVec3, Vec<u32>, Vec<f64>)>> = class
+            let moves: Vec<Option<Decided>> = class
                 .par_iter()
                 .with_min_len(16)
                 .map_init(

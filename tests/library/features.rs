@@ -187,8 +187,11 @@ fn feature_edges_are_kept_in_step_1_and_trisected_in_step_2() {
             }
         };
         let set0: HashSet<_> = segs0.iter().map(key).collect();
+        // The crease rule of the step itself: `fast` keeps the optimize
+        // phase from sliding feature-line vertices along their lines.
         let opts = RefineOptions {
             boundary: Sqrt3Rule::Linear,
+            effort: tetrefine::improve::Effort::Fast,
             ..Default::default()
         };
         refine_step(&mut m, 1, &opts);
