@@ -211,16 +211,26 @@ pub fn read_mesh_with_meta(path: &Path) -> Result<(MeshData, meta::MeshMeta), Io
 pub fn read_mesh_with_meta_noted(
     path: &Path,
 ) -> Result<(MeshData, meta::MeshMeta, Vec<String>), IoError> {
+    let meta = std::fs::metadata(path).map_err(|e| IoError::os(path, None, e))?;
+    if meta.is_dir() {
+        return Err(IoError::file(path, "is a directory, not a mesh file"));
+    }
+    // A stream is copied once before anything reads it: telling a Gmsh
+    // `.msh` from a GiD one reads its first keyword.
+    if !meta.is_file() {
+        return spooled(path, read_mesh_file_with_meta);
+    }
+    read_mesh_file_with_meta(path)
+}
+
+fn read_mesh_file_with_meta(
+    path: &Path,
+) -> Result<(MeshData, meta::MeshMeta, Vec<String>), IoError> {
     if Format::for_reading(path)? == Format::Gmsh {
-        let meta = std::fs::metadata(path).map_err(|e| IoError::os(path, None, e))?;
-        let (d, m) = if meta.is_file() {
-            gmsh::read_with_meta(path)?
-        } else {
-            spooled(path, gmsh::read_with_meta)?
-        };
+        let (d, m) = gmsh::read_with_meta(path)?;
         return Ok((d, m, Vec::new()));
     }
-    let (d, notes) = read_mesh_noted(path)?;
+    let (d, notes) = read_mesh_file(path)?;
     Ok((d, meta::MeshMeta::default(), notes))
 }
 
