@@ -132,14 +132,21 @@ pub fn read_mesh(path: &Path) -> Result<MeshData, IoError> {
 /// mixed-cell `.vtu` other than tetrahedra and triangles, say), one
 /// sentence each.
 pub fn read_mesh_noted(path: &Path) -> Result<(MeshData, Vec<String>), IoError> {
+    read_once(path, read_mesh_file)
+}
+
+/// Runs `read` on the mesh file `path`; a stream is first copied once (see
+/// [`spooled`]), before anything reads it: telling a Gmsh `.msh` from a GiD
+/// one reads its first keyword.
+fn read_once<T>(path: &Path, read: impl FnOnce(&Path) -> Result<T, IoError>) -> Result<T, IoError> {
     let meta = std::fs::metadata(path).map_err(|e| IoError::os(path, None, e))?;
     if meta.is_dir() {
         return Err(IoError::file(path, "is a directory, not a mesh file"));
     }
     if !meta.is_file() {
-        return spooled(path, read_mesh_file);
+        return spooled(path, read);
     }
-    read_mesh_file(path)
+    read(path)
 }
 
 /// Copies the stream `path` once into a temporary regular file with the
@@ -211,16 +218,7 @@ pub fn read_mesh_with_meta(path: &Path) -> Result<(MeshData, meta::MeshMeta), Io
 pub fn read_mesh_with_meta_noted(
     path: &Path,
 ) -> Result<(MeshData, meta::MeshMeta, Vec<String>), IoError> {
-    let meta = std::fs::metadata(path).map_err(|e| IoError::os(path, None, e))?;
-    if meta.is_dir() {
-        return Err(IoError::file(path, "is a directory, not a mesh file"));
-    }
-    // A stream is copied once before anything reads it: telling a Gmsh
-    // `.msh` from a GiD one reads its first keyword.
-    if !meta.is_file() {
-        return spooled(path, read_mesh_file_with_meta);
-    }
-    read_mesh_file_with_meta(path)
+    read_once(path, read_mesh_file_with_meta)
 }
 
 fn read_mesh_file_with_meta(
