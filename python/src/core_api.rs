@@ -153,7 +153,7 @@ pub fn write(
             CellArray::Int32With("parent".into(), n, &parent),
             CellArray::Int32With("marked".into(), n, &mark),
         ];
-        tetrefine::io::vtk::write_vtu(path, mesh, &cells).map_err(|e| e.to_string())
+        tetrefine::io::vtk::write_vtu(path, mesh, None, &cells).map_err(|e| e.to_string())
     } else {
         tetrefine::io::write_mesh(path, mesh).map_err(|e| e.to_string())
     }
