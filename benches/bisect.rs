@@ -3,7 +3,7 @@
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use std::time::Duration;
-use tetrefine::refine::bisect::bisect;
+use tetrefine::bisect;
 
 fn bench_bisect(c: &mut Criterion) {
     let mut group = c.benchmark_group("bisect");
@@ -12,7 +12,7 @@ fn bench_bisect(c: &mut Criterion) {
     group.measurement_time(Duration::from_secs(5));
     // 6 n³ tets: 26 → 105,456; 55 → 998,250.
     for n in [26usize, 55] {
-        let mesh = tetrefine::TetMesh::from_data(&tetrefine::mesh::generate::cube_grid(n))
+        let mesh = tetrefine::TetMesh::from_data(&tetrefine::cube_grid(n))
             .expect("the cube grid is a valid mesh")
             .0;
         let input = mesh.n_tets();

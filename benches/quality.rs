@@ -5,7 +5,7 @@
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use std::hint::black_box;
 use std::time::Duration;
-use tetrefine::mesh::generate::cube_grid;
+use tetrefine::cube_grid;
 use tetrefine::{MeshStats, TetMesh};
 
 fn quality_stats(c: &mut Criterion) {

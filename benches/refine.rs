@@ -13,9 +13,9 @@
 
 use criterion::{criterion_group, criterion_main, BenchmarkGroup, Criterion, Throughput};
 use std::time::Duration;
-use tetrefine::mesh::generate::cube_grid;
-use tetrefine::refine::{refine_step, Phase, RefineOptions};
+use tetrefine::cube_grid;
 use tetrefine::TetMesh;
+use tetrefine::{refine_step, Phase, RefineOptions};
 
 /// Benchmark sizes: label and grid resolution `n` (6n³ tets).
 const SIZES: [(&str, usize); 3] = [
@@ -45,7 +45,7 @@ fn time_steps(
     mesh: &TetMesh,
     opts: &RefineOptions,
     iters: u64,
-    pick: impl Fn(&tetrefine::refine::StepReport) -> f64,
+    pick: impl Fn(&tetrefine::StepReport) -> f64,
 ) -> Duration {
     let mut total = Duration::ZERO;
     for _ in 0..iters {

@@ -17,7 +17,7 @@ fn main() -> ExitCode {
         eprintln!("error: N must be at least 1");
         return ExitCode::FAILURE;
     }
-    let mesh = tetrefine::TetMesh::from_data(&tetrefine::mesh::generate::cube_grid(n))
+    let mesh = tetrefine::TetMesh::from_data(&tetrefine::cube_grid(n))
         .expect("the cube grid is a valid mesh")
         .0;
     match tetrefine::io::write_mesh(&PathBuf::from(out), &mesh) {

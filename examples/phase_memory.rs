@@ -4,7 +4,7 @@
 //! `cargo run --release --example phase_memory -- [MESH | cube:N] [steps]`.
 
 use std::path::Path;
-use tetrefine::refine::{refine_step_with_progress, Phase, Progress, RefineOptions};
+use tetrefine::{refine_step_with_progress, Phase, Progress, RefineOptions};
 
 /// A `/proc/self/status` entry in MiB.
 fn status_mib(key: &str) -> u64 {
@@ -51,7 +51,7 @@ fn main() {
     let mut m = match arg.strip_prefix("cube:") {
         Some(n) => {
             let n = n.parse().expect("cube:N with an integer N");
-            tetrefine::TetMesh::from_data(&tetrefine::mesh::generate::cube_grid(n))
+            tetrefine::TetMesh::from_data(&tetrefine::cube_grid(n))
                 .expect("the cube grid is valid")
                 .0
         }

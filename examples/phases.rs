@@ -2,7 +2,7 @@
 //! alternative to `cargo bench --bench refine`): `cargo run --release
 //! --example phases -- [MESH | cube:N] [steps]`.
 use std::path::Path;
-use tetrefine::refine::{refine_step, RefineOptions};
+use tetrefine::{refine_step, RefineOptions};
 fn main() {
     let arg = std::env::args().nth(1).unwrap_or("cube:37".into());
     let steps: usize = std::env::args()
@@ -11,7 +11,7 @@ fn main() {
         .unwrap_or(1);
     let mut m = match arg.strip_prefix("cube:") {
         Some(n) => {
-            tetrefine::TetMesh::from_data(&tetrefine::mesh::generate::cube_grid(n.parse().unwrap()))
+            tetrefine::TetMesh::from_data(&tetrefine::cube_grid(n.parse().unwrap()))
                 .unwrap()
                 .0
         }

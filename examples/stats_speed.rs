@@ -6,7 +6,7 @@
 //! the CPU time per tet (all threads, from Linux's per-thread schedstat) is
 //! the steadier figure.
 use std::time::Instant;
-use tetrefine::mesh::generate::cube_grid;
+use tetrefine::cube_grid;
 use tetrefine::{MeshStats, TetMesh};
 
 fn main() {

@@ -36,16 +36,22 @@
 #![deny(missing_docs)]
 #![warn(clippy::undocumented_unsafe_blocks)]
 
-pub mod file;
+// Private areas, in dependency order (each uses only those above it):
+// local tables → seeded RNG → file helpers → geometry → mesh store →
+// local operations → improvement → √3 stencils → refinement → report; io,
+// polylines and TetGen are leaves. What a user needs is re-exported below
+// or through the public facade modules (`geom`, `io`, `ops`, `report`,
+// `stencil`, `topo`, `tetgen`), whose own submodules stay private.
+mod file;
 pub mod geom;
-pub mod improve;
+mod improve;
 pub mod io;
-pub mod mesh;
+mod mesh;
 pub mod ops;
-pub mod polyline;
-pub mod refine;
+mod polyline;
+mod refine;
 pub mod report;
-pub mod rng;
+mod rng;
 pub mod stencil;
 #[cfg(feature = "tetgen")]
 pub mod tetgen;
@@ -54,14 +60,26 @@ pub mod topo;
 pub use file::IoError;
 pub use improve::{improve, ImproveOptions, ImproveReport};
 pub use io::{load_mesh, read_mesh, write_mesh};
-pub use mesh::{BuildReport, CheckError, MeshData, MeshError, Remap, TetMesh, Where};
+pub use mesh::generate::cube_grid;
+pub use mesh::{
+    ball_stays_positive, BuildReport, CheckError, MeshData, MeshError, Remap, TetMesh, Where,
+    NO_ADJ,
+};
 pub use ops::OpError;
-pub use refine::marking::{select, MarkStrategy};
+pub use polyline::{
+    write_feature_lines, write_points_csv, write_points_vtp, write_polylines, write_polylines_csv,
+    write_polylines_vtp, PolylineFormat,
+};
+pub use refine::bisect::{bisect, bisect_steps, BisectError};
+pub use refine::features::detect_features;
+pub use refine::marking::{doerfler_count, fraction_count, ranking, select, MarkStrategy};
+pub use refine::parents::{contains, walk_to};
 pub use refine::{
-    locate_parents, refine, refine_step, refine_with, NoProgress, Phase, PhaseReport, Progress,
-    RefineOptions, StepReport,
+    locate_parents, refine, refine_step, refine_step_with_progress, refine_with, NoProgress, Phase,
+    PhaseReport, Progress, RefineOptions, StepReport,
 };
 pub use report::{format_table, write_histogram, MeshStats};
+pub use rng::SplitMix64;
 pub use stencil::Sqrt3Rule;
 
 /// The README's Rust examples, compiled and run as doctests so that they stay

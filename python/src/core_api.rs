@@ -11,20 +11,20 @@
 
 use std::path::Path;
 
-use tetrefine::io::vtk::CellArray;
-use tetrefine::mesh::MeshData;
-use tetrefine::refine::marking::{select, MarkStrategy};
-use tetrefine::refine::step::refine_with;
-use tetrefine::refine::{Phase, Progress, RefineOptions};
-use tetrefine::report::stats::DEFAULT_HIST_MAX_DEG;
+use tetrefine::io::CellArray;
+use tetrefine::refine_with;
 use tetrefine::report::Histogram;
+use tetrefine::report::DEFAULT_HIST_MAX_DEG;
+use tetrefine::MeshData;
 use tetrefine::MeshStats;
+use tetrefine::{select, MarkStrategy};
+use tetrefine::{Phase, Progress, RefineOptions};
 
 /// The core's mesh store.
 pub type TetMesh = tetrefine::TetMesh;
 
 /// Default number of histogram bins of `quality --json` (1° bins over 0–71°).
-pub const DEFAULT_BINS: usize = tetrefine::report::stats::DEFAULT_BINS;
+pub const DEFAULT_BINS: usize = tetrefine::report::DEFAULT_BINS;
 
 /// A mesh as plain arrays, 0-based, before validation.
 #[derive(Default)]
@@ -56,7 +56,7 @@ pub struct BuildNotes {
     pub dropped_edges: usize,
 }
 
-fn notes(r: &tetrefine::mesh::BuildReport) -> BuildNotes {
+fn notes(r: &tetrefine::BuildReport) -> BuildNotes {
     BuildNotes {
         reoriented: r.reoriented,
         unreferenced_points: r.unreferenced_points,
@@ -78,7 +78,7 @@ pub struct BuildFailure {
 /// (`TetMesh::from_data`, as every file reader does), then compacts it so
 /// that slot `i` is the `i`-th tet.
 pub fn build(input: Input) -> Result<(TetMesh, BuildNotes), BuildFailure> {
-    use tetrefine::mesh::MeshError as E;
+    use tetrefine::MeshError as E;
     let data = MeshData {
         points: input.points,
         tets: input.tets,
@@ -153,7 +153,7 @@ pub fn write(
             CellArray::Int32With("parent".into(), n, &parent),
             CellArray::Int32With("marked".into(), n, &mark),
         ];
-        tetrefine::io::vtk::write_vtu(path, mesh, None, &cells).map_err(|e| e.to_string())
+        tetrefine::io::write_vtu(path, mesh, None, &cells).map_err(|e| e.to_string())
     } else {
         tetrefine::io::write_mesh(path, mesh).map_err(|e| e.to_string())
     }
@@ -232,7 +232,7 @@ pub fn quality_json(mesh: &TetMesh, bins: usize) -> String {
 /// the cell arrays of the `.vtu` writer.
 pub fn tet_quality(mesh: &TetMesh) -> [Vec<f64>; 4] {
     use rayon::prelude::*;
-    use tetrefine::geom::quality::{tet_quality, tet_volume};
+    use tetrefine::geom::{tet_quality, tet_volume};
     let per: Vec<[f64; 4]> = (0..mesh.n_tets() as u32)
         .into_par_iter()
         .map(|t| {
@@ -273,6 +273,10 @@ pub struct RefineArgs {
     pub step_offset: usize,
     /// Also compute `quality --json` after every step.
     pub stats: bool,
+    /// `--allow-empty`: a selection of no tet is not an error.
+    pub allow_empty: bool,
+    /// `--allow-steps-zero`: `steps = 0` is not an error.
+    pub allow_steps_zero: bool,
 }
 
 /// What went wrong in [`refine`]: bad options (a `ValueError`) or a file.
@@ -374,10 +378,22 @@ pub fn refine(
             a.feature_angle
         )));
     }
+    if a.steps == 0 && !a.allow_steps_zero {
+        return Err(Value(
+            "steps=0 refines nothing; give steps >= 1 (or allow_steps_zero=True to get the mesh unrefined)".into(),
+        ));
+    }
     let st = strategy(&a.marks, indicator.is_some()).map_err(Value)?;
     let selection = match &st {
         Some(st) => {
-            Some(select(st, indicator, input).map_err(|e| Value(format!("mark {st}: {e}")))?)
+            let sel = select(st, indicator, input).map_err(|e| Value(format!("mark {st}: {e}")))?;
+            if !a.allow_empty && !sel.iter().any(|&x| x) {
+                return Err(Value(format!(
+                    "mark {st} selects none of the {} tets; nothing would be refined (allow_empty=True returns the mesh unrefined)",
+                    input.n_tets()
+                )));
+            }
+            Some(sel)
         }
         None => None,
     };
@@ -396,8 +412,8 @@ pub fn refine(
     let mut mesh = input.clone();
     let t_copy = lap();
     {
-        use tetrefine::io::edges::read_edge_list;
-        use tetrefine::refine::features::detect_features;
+        use tetrefine::detect_features;
+        use tetrefine::io::read_edge_list;
         match a.features.as_str() {
             "none" => mesh.clear_features(),
             "auto" => {
@@ -465,7 +481,7 @@ pub fn locate(
     selection: Option<&[bool]>,
 ) -> (Vec<u32>, Vec<bool>) {
     use rayon::prelude::*;
-    use tetrefine::refine::parents::walk_to;
+    use tetrefine::walk_to;
     let first = input.tet_ids().next().unwrap_or(0);
     let parents: Vec<u32> = (0..mesh.n_tets() as u32)
         .into_par_iter()
@@ -496,7 +512,7 @@ pub fn improve(
     passes: usize,
     threshold: f64,
 ) -> Result<(TetMesh, String), String> {
-    use tetrefine::improve::{improve, ImproveOptions};
+    use tetrefine::{improve, ImproveOptions};
     if !(threshold > 0.0 && threshold < 1.0) {
         return Err(format!("threshold={threshold} must lie in (0, 1) (a sine)"));
     }
@@ -520,7 +536,7 @@ pub fn bisect(input: &TetMesh, steps: usize) -> Result<(TetMesh, Vec<String>), S
     let mut reports = Vec::new();
     for s in 1..=steps {
         let t0 = std::time::Instant::now();
-        mesh = tetrefine::refine::bisect::bisect(&mesh).map_err(|e| format!("step {s}: {e}"))?;
+        mesh = tetrefine::bisect(&mesh).map_err(|e| format!("step {s}: {e}"))?;
         mesh.compact();
         reports.push(
             serde_json::json!({
@@ -560,7 +576,7 @@ pub struct MeshArgs {
 /// a file error, `Err` any other.
 #[cfg(feature = "tetgen")]
 pub fn mesh_surface(surface: Surface<'_>, a: MeshArgs) -> Result<Result<TetMesh, String>, String> {
-    use tetrefine::io::plc::Plc;
+    use tetrefine::io::Plc;
     use tetrefine::tetgen::{switches, tetrahedralize, Options};
     let opts = Options {
         min_ratio: a.min_ratio,

@@ -566,6 +566,10 @@ impl Mesh {
     ///                 every phase (an exception it raises stops the run).
     ///   stats         Also compute quality() after every step, into the
     ///                 step's report as "quality" [--stats].
+    ///   allow_empty   A selection that selects no tet returns the mesh
+    ///                 unrefined instead of raising ValueError [--allow-empty].
+    ///   allow_steps_zero  steps=0 returns the mesh unrefined instead of
+    ///                 raising ValueError [--allow-steps-zero].
     ///
     /// The GIL is released while the mesh is refined. Ctrl-C (SIGINT) stops
     /// the run at the start of the next phase and raises KeyboardInterrupt.
@@ -575,8 +579,9 @@ impl Mesh {
         signature = (steps=1, *, boundary="interpolating", opt_passes=3, threshold=0.3,
                      stop_after=None, features=PathOrName("auto".into()), feature_angle=45.0, indicator=None,
                      mark=None, region=None, r#box=None, sphere=None, smooth="refined",
-                     step_offset=0, progress=None, stats=false),
-        text_signature = "(self, steps=1, *, boundary='interpolating', opt_passes=3, threshold=0.3, stop_after=None, features='auto', feature_angle=45.0, indicator=None, mark='doerfler:0.5', region=None, box=None, sphere=None, smooth='refined', step_offset=0, progress=False, stats=False)"
+                     step_offset=0, progress=None, stats=false, allow_empty=false,
+                     allow_steps_zero=false),
+        text_signature = "(self, steps=1, *, boundary='interpolating', opt_passes=3, threshold=0.3, stop_after=None, features='auto', feature_angle=45.0, indicator=None, mark='doerfler:0.5', region=None, box=None, sphere=None, smooth='refined', step_offset=0, progress=False, stats=False, allow_empty=False, allow_steps_zero=False)"
     )]
     #[allow(clippy::too_many_arguments)]
     fn refine(
@@ -598,6 +603,8 @@ impl Mesh {
         step_offset: usize,
         progress: Option<&Bound<'_, PyAny>>,
         stats: bool,
+        allow_empty: bool,
+        allow_steps_zero: bool,
     ) -> PyResult<Mesh> {
         let smooth_refined = match smooth {
             "refined" => true,
@@ -638,6 +645,8 @@ impl Mesh {
             smooth_refined,
             step_offset,
             stats,
+            allow_empty,
+            allow_steps_zero,
         };
         // progress: None/False, True (lines on stderr) or a callable.
         let (print, callback): (bool, Option<Py<PyAny>>) = match progress {

@@ -24,6 +24,12 @@ FILE_FLAGS = {
     "--parent-map": "parent",
     "--help": None,
     "--version": None,
+    # Mesh.write picks the format by extension and writes MSH 4.1 ASCII;
+    # the 2.2 and binary variants are the CLI's only.
+    "--msh-format": "write",
+    # The memory guard is the CLI's (it estimates a process's peak from
+    # /proc/meminfo); the package has none yet.
+    "--max-memory": None,
 }
 
 

@@ -117,6 +117,21 @@ def test_bad_options():
         m.quality(bins=0)
 
 
+def test_nothing_to_refine_is_an_error_unless_allowed():
+    m = tetrefine.read(TRIPOD)
+    # A sphere far outside the tripod's bounding box holds no centroid.
+    far = [1e6, 1e6, 1e6, 1.0]
+    with pytest.raises(ValueError, match="selects none of the 2799 tets"):
+        m.refine(sphere=far)
+    with pytest.raises(ValueError, match="steps=0 refines nothing"):
+        m.refine(0)
+    for same in (m.refine(sphere=far, allow_empty=True), m.refine(0, allow_steps_zero=True)):
+        assert same.n_tets == m.n_tets
+        # The store renumbers (compact orders points along a curve), so
+        # compare the point sets.
+        assert np.array_equal(np.unique(same.points, axis=0), np.unique(m.points, axis=0))
+
+
 def test_file_errors(tmp_path):
     with pytest.raises(FileNotFoundError, match="no such file"):
         tetrefine.read(tmp_path / "missing.mesh")

@@ -1,7 +1,7 @@
 //! Geometry: exact orientation predicates and tetrahedron quality measures.
 
-pub mod predicates;
-pub mod quality;
+pub(crate) mod predicates;
+pub(crate) mod quality;
 
 pub use predicates::{
     all_positive, is_positive, orient3d, orient3d_sign, positive_in_doubles, Orientation,

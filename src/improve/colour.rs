@@ -121,17 +121,13 @@ impl Balls {
         self.offsets.len().saturating_sub(1)
     }
 
-    /// Whether there are no balls.
-    pub fn is_empty(&self) -> bool {
-        self.len() == 0
-    }
-
     /// Ball `i`.
     pub fn ball(&self, i: usize) -> &[u32] {
         &self.tets[self.offsets[i]..self.offsets[i + 1]]
     }
 }
 
+#[allow(dead_code)] // TEMP(merge): used by the quality branch's boundary smoothing
 /// Greedy colouring of the balls' vertices `verts` (ball `i` is the ball of
 /// `verts[i]`), visited in order: each takes the smallest colour no earlier
 /// vertex sharing a tet with it has. Returns the colour classes as lists of
@@ -188,6 +184,7 @@ pub fn colour_balls_except(
     all
 }
 
+#[allow(dead_code)] // TEMP(merge): used by the quality branch's boundary smoothing
 /// Colour classes of `verts` (see [`colour_balls`]) as lists of vertex ids:
 /// within a class no two vertices share a tet.
 pub fn colour_classes(mesh: &TetMesh, verts: &[u32]) -> Vec<Vec<u32>> {
@@ -236,4 +233,154 @@ pub fn sequential_levels(
         level[verts[i as usize] as usize] = 0;
     }
     groups
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::collections::HashSet;
+
+    /// The shipped tripod: a real mesh with irregular balls.
+    fn tripod() -> TetMesh {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("meshes/tripod.mesh");
+        crate::io::load_mesh(&path).unwrap().0
+    }
+
+    fn in_pool<R: Send>(threads: usize, f: impl FnOnce() -> R + Send) -> R {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(f)
+    }
+
+    #[test]
+    fn colour_classes_of_the_tripod_are_independent_sets() {
+        let mesh = tripod();
+        let fixed = mesh.fixed_vertices();
+        let verts: Vec<u32> = (0..mesh.n_points() as u32)
+            .filter(|&v| !fixed[v as usize] && mesh.tet_of_vertex(v).is_some())
+            .collect();
+        assert!(verts.len() > 100, "the tripod has interior vertices");
+        let classes = colour_classes(&mesh, &verts);
+        assert!(classes.len() > 1);
+        // Every vertex is in exactly one class.
+        let mut seen = HashSet::new();
+        for c in &classes {
+            for &v in c {
+                assert!(seen.insert(v), "vertex {v} in two classes");
+            }
+        }
+        assert_eq!(seen.len(), verts.len());
+        // No tet holds two vertices of one class.
+        for c in &classes {
+            let class: HashSet<u32> = c.iter().copied().collect();
+            for t in mesh.tet_ids() {
+                let k = mesh.tet(t).iter().filter(|v| class.contains(v)).count();
+                assert!(k <= 1, "tet {t} holds {k} vertices of one class");
+            }
+        }
+    }
+
+    #[test]
+    fn vertices_set_apart_get_classes_of_their_own_before_and_after() {
+        let mesh = tripod();
+        let fixed = mesh.fixed_vertices();
+        let verts: Vec<u32> = (0..mesh.n_points() as u32)
+            .filter(|&v| !fixed[v as usize] && mesh.tet_of_vertex(v).is_some())
+            .collect();
+        let balls = Balls::gather(&mesh, &verts);
+        let apart: Vec<u32> = (0..verts.len() as u32).filter(|i| i % 7 == 0).collect();
+        let classes = colour_balls_except(&mesh, &balls, &verts, |i| i % 7 == 0);
+        let k = apart.len();
+        let expected: Vec<Vec<u32>> = apart.iter().map(|&i| vec![i]).collect();
+        assert_eq!(&classes[..k], &expected[..]);
+        assert_eq!(&classes[classes.len() - k..], &expected[..]);
+        // The classes in between hold every other vertex once, independently.
+        let mut seen = HashSet::new();
+        for c in &classes[k..classes.len() - k] {
+            let mut tets = HashSet::new();
+            for &i in c {
+                assert!(i % 7 != 0 && seen.insert(i));
+                for &t in balls.ball(i as usize) {
+                    assert!(tets.insert(t), "tet {t} shared within a class");
+                }
+            }
+        }
+        assert_eq!(seen.len() + k, verts.len());
+    }
+
+    #[test]
+    fn gathered_balls_are_the_walked_balls_in_ascending_order() {
+        let mesh = tripod();
+        // Every other vertex, so that the index has holes.
+        let verts: Vec<u32> = (0..mesh.n_points() as u32).step_by(2).collect();
+        let mut walked = Vec::new();
+        for threads in [1, 3] {
+            let balls = in_pool(threads, || Balls::gather(&mesh, &verts));
+            assert_eq!(balls.len(), verts.len());
+            for (i, &v) in verts.iter().enumerate() {
+                mesh.ball(v, &mut walked);
+                walked.sort_unstable();
+                assert_eq!(balls.ball(i), &walked[..], "ball of {v}, {threads} threads");
+            }
+        }
+        assert_eq!(Balls::gather(&mesh, &[]).len(), 0);
+    }
+
+    #[test]
+    fn dependency_levels_keep_every_earlier_conflict_earlier() {
+        let mesh = tripod();
+        let verts: Vec<u32> = (0..mesh.n_points() as u32)
+            .filter(|&v| mesh.tet_of_vertex(v).is_some())
+            .collect();
+        let balls = Balls::gather(&mesh, &verts);
+        // A stretch of neighbours in memory, each visited twice, as the vertices
+        // set apart are (before and after the colour classes).
+        let mut seq: Vec<u32> = (0..200).collect();
+        seq.extend(0..200u32);
+        let mut level = Vec::new();
+        let groups = sequential_levels(&mesh, &balls, &verts, &seq, &mut level);
+        assert!(level.iter().all(|&l| l == 0), "scratch left clean");
+        // Entry k of seq is the k-th occurrence, in group order, of its index.
+        let mut group_of = vec![Vec::new(); seq.len()];
+        for (g, group) in groups.iter().enumerate() {
+            for &i in group {
+                group_of[i as usize].push(g);
+            }
+        }
+        let mut seen = vec![0usize; seq.len()];
+        let entry_group: Vec<usize> = seq
+            .iter()
+            .map(|&i| {
+                let g = group_of[i as usize][seen[i as usize]];
+                seen[i as usize] += 1;
+                g
+            })
+            .collect();
+        let shares = |a: u32, b: u32| {
+            let (ba, bb) = (balls.ball(a as usize), balls.ball(b as usize));
+            a == b || ba.iter().any(|t| bb.contains(t))
+        };
+        let mut conflicts = 0;
+        for k in 0..seq.len() {
+            for j in 0..k {
+                if shares(seq[j], seq[k]) {
+                    conflicts += 1;
+                    assert!(entry_group[j] < entry_group[k], "entries {j} and {k}");
+                }
+            }
+        }
+        assert!(
+            conflicts > seq.len(),
+            "the stretch is connected: {conflicts}"
+        );
+        for group in &groups {
+            for (a, &x) in group.iter().enumerate() {
+                for &y in &group[..a] {
+                    assert!(!shares(x, y), "{x} and {y} share a tet in one group");
+                }
+            }
+        }
+    }
 }

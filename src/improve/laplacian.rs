@@ -1,7 +1,7 @@
 //! Laplacian smoothing: the vertex goes to the centroid of its neighbours
 //! (Field 1988), kept only if the worst tet of its ball improves.
 
-use super::{ball_min_mean_at, BallPoints};
+use super::BallPoints;
 use crate::mesh::TetMesh;
 use glam::DVec3;
 
@@ -17,6 +17,7 @@ pub struct BallNow {
     pub first: usize,
 }
 
+#[allow(dead_code)] // TEMP(merge): used by the quality branch's boundary smoothing
 /// Where [`laplacian_smooth`] would move `v`, without moving it: the
 /// Laplacian target and the ball's new worst quality, if the target raises the
 /// worst quality above `now.worst` without lowering the mean below `now.mean`
@@ -72,18 +73,4 @@ pub fn laplacian_position_in(
     }
     let mean = sum / ball.len().max(1) as f64;
     (mean >= current_mean && bp.stays_positive(x)).then_some((x, q))
-}
-
-/// Moves `v` to its Laplacian target if that raises the ball's worst quality
-/// above `current` without lowering the ball's mean quality or inverting
-/// anything. Returns the new worst quality if it moved.
-pub fn laplacian_smooth(mesh: &mut TetMesh, v: u32, ball: &[u32], current: f64) -> Option<f64> {
-    let now = BallNow {
-        worst: current,
-        mean: ball_min_mean_at(mesh, v, ball, mesh.point(v)).1,
-        first: usize::MAX,
-    };
-    let (x, q) = laplacian_position(mesh, v, ball, now, &mut Vec::new())?;
-    mesh.set_point(v, x);
-    Some(q)
 }

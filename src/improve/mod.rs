@@ -13,33 +13,11 @@ pub mod ring;
 pub use passes::{improve, ImproveOptions, ImproveReport};
 
 use crate::geom::{all_positive, tet_min_sine};
-use crate::mesh::{tet_points_with, TetMesh};
+use crate::mesh::TetMesh;
 use glam::DVec3;
 use std::cell::RefCell;
 
-/// Smallest quality over the tets of `ball` if vertex `v` stood at `x`.
-pub fn ball_quality_at(mesh: &TetMesh, v: u32, ball: &[u32], x: DVec3) -> f64 {
-    let mut q = f64::INFINITY;
-    for &t in ball {
-        let p = tet_points_with(mesh, t, v, x);
-        q = q.min(tet_min_sine(&p));
-    }
-    q
-}
-
-/// Smallest and mean quality over the tets of `ball` if vertex `v` stood at `x`.
-pub fn ball_min_mean_at(mesh: &TetMesh, v: u32, ball: &[u32], x: DVec3) -> (f64, f64) {
-    let mut q = f64::INFINITY;
-    let mut sum = 0.0;
-    for &t in ball {
-        let p = tet_points_with(mesh, t, v, x);
-        let s = tet_min_sine(&p);
-        q = q.min(s);
-        sum += s;
-    }
-    (q, sum / ball.len().max(1) as f64)
-}
-
+#[allow(dead_code)] // TEMP(merge): used by the quality branch's boundary smoothing
 /// Smallest quality over the tets of `ball` as they stand.
 pub fn ball_quality(mesh: &TetMesh, ball: &[u32]) -> f64 {
     ball.iter()
@@ -73,7 +51,7 @@ fn with_stamps<R>(n_points: usize, v: u32, f: impl FnOnce(&mut [u32], u32) -> R)
 
 /// The corners of every tet of a vertex's ball, loaded once, so that the
 /// ball's qualities with the vertex at trial positions need no lookups in the
-/// mesh. Each evaluation computes exactly what [`tet_points_with`] followed by
+/// mesh. Each evaluation computes exactly what `mesh::moves::tet_points_with` followed by
 /// [`tet_min_sine`] (or [`orient3d`]) computes.
 #[derive(Clone, Debug, Default)]
 pub struct BallPoints {
@@ -126,11 +104,6 @@ impl BallPoints {
     /// Number of tets.
     pub fn len(&self) -> usize {
         self.pts.len()
-    }
-
-    /// Whether the ball is empty.
-    pub fn is_empty(&self) -> bool {
-        self.pts.is_empty()
     }
 
     /// Corners of tet `i` of the ball with the vertex at `x`.

@@ -64,20 +64,9 @@ fn min_norm_in_hull(g: &[DVec3]) -> DVec3 {
     x
 }
 
-/// Optimises the position of `v`; returns the new minimum quality if it moved.
-pub fn optimize_vertex(
-    mesh: &mut TetMesh,
-    v: u32,
-    ball: &[u32],
-    params: &OptimizeParams,
-) -> Option<f64> {
-    let (x, q) = optimize_position(mesh, v, mesh.point(v), ball, params)?;
-    mesh.set_point(v, x);
-    Some(q)
-}
-
-/// Where [`optimize_vertex`] would move `v` if it stood at `x0`, without
-/// moving it: the optimised position and the ball's new minimum quality, if
+#[allow(dead_code)] // TEMP(merge): used by the quality branch's boundary smoothing
+/// Where the optimiser would move `v` if it stood at `x0`, without moving
+/// it: the optimised position and the ball's new minimum quality, if
 /// that is above the minimum at `x0`.
 pub fn optimize_position(
     mesh: &TetMesh,

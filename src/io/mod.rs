@@ -6,24 +6,43 @@
 //! the file and, where there is one, the line. Writers go through
 //! [`write_atomic`], so a failed write never leaves a partial file behind.
 
-pub mod edges;
-pub mod fields;
-pub mod gid;
-pub mod gmsh;
-pub mod indicator;
-pub mod medit;
-pub mod meshb;
-pub mod meta;
-pub mod off;
-pub mod plc;
-pub mod poly;
-pub mod stl;
-pub mod tetgen;
+pub(crate) mod edges;
+pub(crate) mod fields;
+pub(crate) mod gid;
+pub(crate) mod gmsh;
+pub(crate) mod indicator;
+pub(crate) mod medit;
+pub(crate) mod meshb;
+pub(crate) mod meta;
+pub(crate) mod off;
+pub(crate) mod plc;
+pub(crate) mod poly;
+pub(crate) mod stl;
+pub(crate) mod tetgen;
 mod text;
-pub mod vtk;
+pub(crate) mod vtk;
 
 pub use text::Tokens;
 
+pub use edges::read_edge_list;
+pub use fields::{add_sol_fields, write_point_fields};
+pub use gmsh::MshFormat;
+pub use indicator::{read_indicator, IndicatorSource};
+pub use meshb::{read_sol, write_sol, SolAt, SolFile, Solution};
+pub use meta::{Field, MeshMeta};
+pub use plc::{Facet, Plc, PlcError, PlcVolume, Region};
+/// The pieces of a VTK XML PolyData (`.vtp`) file, for writers of other
+/// polygonal data (the surface schemes' meshes) that share the layout of
+/// the feature-line files.
+pub mod vtp {
+    pub use crate::polyline::{write_cells, write_footer, write_header, write_points};
+}
+pub use vtk::{
+    read_noted as read_vtu_noted, read_tet_cell_array, write_vtu, CellArray, TetCellArray,
+    VtuSummary,
+};
+
+pub(crate) use crate::file::open_message;
 /// The file helpers (errors, whole-file reads, atomic writes and output
 /// sets) live below every area, in [`crate::file`], so that report and the
 /// surface schemes share them without going through `io`.
@@ -31,7 +50,7 @@ pub use crate::file::{
     install_signal_cleanup, remove_stale_temporaries, temporary_path, write_atomic, IoError,
     IoErrorKind, OutputSet, TEMP_MARKER,
 };
-pub(crate) use crate::file::{open_message, read_bytes};
+pub use crate::file::{read_bytes, read_text};
 
 use crate::mesh::{MeshData, TetMesh};
 use std::fs::File;

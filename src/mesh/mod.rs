@@ -29,7 +29,7 @@ pub use build::{BuildReport, MeshError, Where};
 pub use check::CheckError;
 pub use compact::Remap;
 pub use data::MeshData;
-pub use moves::{ball_stays_positive, tet_points_with};
+pub use moves::ball_stays_positive;
 
 use crate::topo::{TET_EDGES, TET_EDGE_OPPOSITE, TET_FACES};
 use fasthash::{FastHashMap, FastHashSet};

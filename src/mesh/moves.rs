@@ -6,7 +6,7 @@ use glam::DVec3;
 
 /// The corners of tet `t` with vertex `v` (if it is one of them) standing at `x`.
 #[inline]
-pub fn tet_points_with(mesh: &TetMesh, t: u32, v: u32, x: DVec3) -> [DVec3; 4] {
+pub(crate) fn tet_points_with(mesh: &TetMesh, t: u32, v: u32, x: DVec3) -> [DVec3; 4] {
     let tv = mesh.tet(t);
     let mut p = mesh.tet_points(t);
     for (pi, &vi) in p.iter_mut().zip(&tv) {

@@ -7,16 +7,16 @@
 //! flat tet returns [`OpError::WouldInvert`] and leaves the mesh untouched.
 //! The shared re-linking lives here in [`replace_cavity`].
 
-pub mod bulk_flip;
-pub mod bulk_split;
-pub mod edge_removal;
-pub mod flip23;
-pub mod flip32;
-pub mod flip_repair;
-pub mod interface;
-pub mod split13;
-pub mod split14;
-pub mod trisect;
+pub(crate) mod bulk_flip;
+pub(crate) mod bulk_split;
+pub(crate) mod edge_removal;
+pub(crate) mod flip23;
+pub(crate) mod flip32;
+pub(crate) mod flip_repair;
+pub(crate) mod interface;
+pub(crate) mod split13;
+pub(crate) mod split14;
+pub(crate) mod trisect;
 
 use crate::mesh::{face_key, FaceKey, TetMesh, NO_ADJ};
 use crate::topo::TET_FACES;

@@ -7,10 +7,10 @@
 use crate::support::{kuhn_mesh, Rng};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
-use tetrefine::io::indicator::{read_indicator, IndicatorSource};
-use tetrefine::io::vtk::{write_vtu, CellArray};
-use tetrefine::refine::marking::{select, MarkStrategy};
+use tetrefine::io::{read_indicator, IndicatorSource};
+use tetrefine::io::{write_vtu, CellArray};
 use tetrefine::TetMesh;
+use tetrefine::{select, MarkStrategy};
 
 /// Values of all kinds of magnitudes, with ties and zeros.
 fn sample_values(n: usize, seed: u64) -> Vec<f64> {

@@ -6,7 +6,7 @@
 //! in CI (`tests/mmg_roundtrip.py`).
 
 use crate::support::path;
-use tetrefine::io::{medit, meshb, read_mesh};
+use tetrefine::io::read_mesh;
 
 /// `meshes/mmg_cube.mesh` with other tools' sections inserted after
 /// `Dimension 3` and before `End`.
@@ -25,8 +25,8 @@ fn other_tools_keywords_are_skipped_and_the_mesh_is_the_same() {
     let dir = tempfile::tempdir().unwrap();
     let p = dir.path().join("foreign.mesh");
     std::fs::write(&p, with_foreign_keywords("ISolAtVertices\n2\n1\n2\n")).unwrap();
-    let plain = medit::read(&path("meshes/mmg_cube.mesh")).unwrap();
-    let mut got = medit::read(&p).unwrap();
+    let plain = read_mesh(&path("meshes/mmg_cube.mesh")).unwrap();
+    let mut got = read_mesh(&p).unwrap();
     got.tet_lines = plain.tet_lines.clone(); // the inserted lines shift them
     assert_eq!(got, plain);
 }
@@ -50,7 +50,7 @@ fn a_malformed_known_section_after_foreign_ones_is_still_an_error_at_its_line() 
         .unwrap()
         .0
         + 1;
-    let err = medit::read(&p).unwrap_err();
+    let err = read_mesh(&p).unwrap_err();
     assert_eq!(
         err.line,
         Some(last),
@@ -64,7 +64,7 @@ fn a_file_without_the_version_line_is_not_taken_for_a_mesh() {
     let dir = tempfile::tempdir().unwrap();
     let p = dir.path().join("text.mesh");
     std::fs::write(&p, "hello world\n").unwrap();
-    let err = medit::read(&p).unwrap_err();
+    let err = read_mesh(&p).unwrap_err();
     assert_eq!(err.line, Some(1));
 }
 
@@ -99,7 +99,7 @@ fn a_truncated_or_corrupt_meshb_is_an_error_naming_a_byte() {
     for cut in [7, 20, 100, bytes.len() / 2, bytes.len() - 9] {
         let p = dir.path().join(format!("cut{cut}.meshb"));
         std::fs::write(&p, &bytes[..cut]).unwrap();
-        let err = meshb::read(&p).unwrap_err();
+        let err = read_mesh(&p).unwrap_err();
         assert!(err.to_string().contains(p.to_str().unwrap()), "{err}");
     }
     // A vertex count larger than the file.
@@ -107,7 +107,7 @@ fn a_truncated_or_corrupt_meshb_is_an_error_naming_a_byte() {
     bad[28..32].copy_from_slice(&1_000_000i32.to_le_bytes());
     let p = dir.path().join("count.meshb");
     std::fs::write(&p, &bad).unwrap();
-    let err = meshb::read(&p).unwrap_err().to_string();
+    let err = read_mesh(&p).unwrap_err().to_string();
     assert!(
         err.contains("at byte 28") && err.contains("1000000"),
         "{err}"

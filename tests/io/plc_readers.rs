@@ -4,7 +4,7 @@
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
-use tetrefine::io::plc::{Facet, Plc, PlcError};
+use tetrefine::io::{Facet, Plc, PlcError};
 
 /// The unit cube's corners: point `i` has coordinates given by its bits.
 fn cube_points() -> Vec<[f64; 3]> {

@@ -14,7 +14,7 @@ fn interface_faces(mesh: &TetMesh) -> usize {
     let mut n = 0;
     for t in mesh.tet_ids() {
         for h in mesh.adj(t) {
-            if h != tetrefine::mesh::NO_ADJ {
+            if h != tetrefine::NO_ADJ {
                 let u = h >> 2;
                 if u > t && mesh.region(u) != mesh.region(t) {
                     n += 1;

@@ -5,10 +5,10 @@
 //! seeded jittered cube with free slots, an adaptive selection, flips
 //! refused on purpose, and the flip phase repairing an invalid flip first.
 
+use tetrefine::ball_stays_positive;
+use tetrefine::cube_grid;
 use tetrefine::geom::orient3d;
 use tetrefine::io::load_mesh;
-use tetrefine::mesh::ball_stays_positive;
-use tetrefine::mesh::generate::cube_grid;
 use tetrefine::ops::{
     flip23, flip23_bulk, flip23_valid, flip32, make_flips_valid, split14, split14_bulk, FlipBatch,
 };
@@ -259,8 +259,8 @@ fn bulk_equals_one_by_one_with_refused_flips() {
 /// inside, x + y < 1) and then flips in bulk: 8 children + 1 = 9 tets.
 #[test]
 fn the_flip_phase_repairs_an_invalid_flip_and_then_flips_in_bulk() {
-    use tetrefine::mesh::MeshData;
-    use tetrefine::refine::{refine_step, Phase, RefineOptions};
+    use tetrefine::MeshData;
+    use tetrefine::{refine_step, Phase, RefineOptions};
     let data = MeshData {
         points: vec![
             [0.0, 0.0, 0.0],
@@ -448,7 +448,7 @@ fn dependent_repairs(mesh: &TetMesh, faces: &[(u32, usize)]) -> usize {
 /// makes the very moves of the one-by-one repair.
 #[test]
 fn parallel_flip_repair_equals_the_one_by_one_repair_after_a_step() {
-    use tetrefine::refine::{refine_step, RefineOptions};
+    use tetrefine::{refine_step, RefineOptions};
     let mut mesh = jittered_cube(4, 3);
     refine_step(&mut mesh, 1, &RefineOptions::default());
     let (moved, before, after, dependent) = compare_repairs(&mesh);
@@ -460,7 +460,7 @@ fn parallel_flip_repair_equals_the_one_by_one_repair_after_a_step() {
 /// The same on the tripod (a real mesh with three regions) after one step.
 #[test]
 fn parallel_flip_repair_equals_the_one_by_one_repair_on_the_refined_tripod() {
-    use tetrefine::refine::{refine_step, RefineOptions};
+    use tetrefine::{refine_step, RefineOptions};
     let (mut mesh, _) = load_mesh(&crate::support::path("meshes/tripod.mesh")).unwrap();
     refine_step(&mut mesh, 1, &RefineOptions::default());
     let (moved, before, after, dependent) = compare_repairs(&mesh);

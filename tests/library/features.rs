@@ -8,12 +8,12 @@
 use glam::DVec3;
 use std::collections::{BTreeMap, HashSet};
 use std::path::Path;
+use tetrefine::cube_grid;
+use tetrefine::detect_features;
 use tetrefine::geom::{orient3d, tet_volume};
 use tetrefine::io::load_mesh;
-use tetrefine::mesh::generate::cube_grid;
-use tetrefine::mesh::{MeshData, TetMesh, NO_ADJ};
-use tetrefine::refine::features::detect_features;
-use tetrefine::refine::{locate_parents, refine_step, RefineOptions, Sqrt3Rule};
+use tetrefine::{locate_parents, refine_step, RefineOptions, Sqrt3Rule};
+use tetrefine::{MeshData, TetMesh, NO_ADJ};
 
 fn load(name: &str) -> TetMesh {
     load_mesh(&Path::new("meshes").join(name)).unwrap().0

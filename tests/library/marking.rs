@@ -8,8 +8,8 @@
 #![allow(clippy::needless_range_loop)]
 
 use crate::support::{centroid, kuhn_mesh, Rng};
-use tetrefine::refine::marking::{doerfler_count, fraction_count, ranking, select, MarkStrategy};
 use tetrefine::TetMesh;
+use tetrefine::{doerfler_count, fraction_count, ranking, select, MarkStrategy};
 
 fn parse(s: &str) -> MarkStrategy {
     s.parse()

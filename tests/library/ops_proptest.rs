@@ -6,10 +6,11 @@ use glam::DVec3;
 use proptest::prelude::*;
 use std::collections::BTreeSet;
 use tetrefine::geom::{orient3d, tet_volume};
-use tetrefine::mesh::{face_key, MeshData, TetMesh};
 use tetrefine::ops::{
     flip23, flip32, remove_edge, split14, split_boundary_face, EdgeRing, OpError,
 };
+use tetrefine::topo::face_key;
+use tetrefine::{MeshData, TetMesh};
 
 fn build(points: &[DVec3], tets: &[[u32; 4]]) -> Option<TetMesh> {
     let data = MeshData {

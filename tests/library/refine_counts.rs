@@ -3,8 +3,8 @@
 //! `split`, 4n + n_i after `flip`, + 2·n_b after `boundary-split`.
 
 use tetrefine::io::load_mesh;
-use tetrefine::refine::{refine_step, Phase, RefineOptions, Sqrt3Rule};
 use tetrefine::MeshStats;
+use tetrefine::{refine_step, Phase, RefineOptions, Sqrt3Rule};
 
 fn tripod() -> tetrefine::TetMesh {
     load_mesh(&crate::support::path("meshes/tripod.mesh"))
@@ -12,7 +12,7 @@ fn tripod() -> tetrefine::TetMesh {
         .0
 }
 
-fn run(stop: Phase) -> (tetrefine::TetMesh, tetrefine::refine::StepReport) {
+fn run(stop: Phase) -> (tetrefine::TetMesh, tetrefine::StepReport) {
     let mut m = tripod();
     // The counted phases come before boundary smoothing; the linear rule
     // would refuse the flips of the tripod's bent (not exactly coplanar)

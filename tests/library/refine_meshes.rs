@@ -4,8 +4,8 @@
 
 use std::path::Path;
 use tetrefine::io::load_mesh;
-use tetrefine::refine::{features::detect_features, refine_step, RefineOptions, Sqrt3Rule};
 use tetrefine::MeshStats;
+use tetrefine::{detect_features, refine_step, RefineOptions, Sqrt3Rule};
 
 const MESHES: [&str; 7] = [
     "tripod.mesh",

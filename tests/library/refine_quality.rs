@@ -3,10 +3,10 @@
 //! 4.9° / 28.4° after step 2), and `improve` on every mesh in meshes/.
 
 use std::path::Path;
-use tetrefine::improve::{improve, ImproveOptions};
 use tetrefine::io::load_mesh;
-use tetrefine::refine::{refine_step, RefineOptions, Sqrt3Rule};
 use tetrefine::MeshStats;
+use tetrefine::{improve, ImproveOptions};
+use tetrefine::{refine_step, RefineOptions, Sqrt3Rule};
 
 #[test]
 fn tripod_beats_table_1_in_every_boundary_mode() {

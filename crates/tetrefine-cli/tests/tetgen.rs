@@ -13,9 +13,9 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use tetrefine::geom::tet_volume;
-use tetrefine::io::plc::{Facet, Plc};
-use tetrefine::mesh::NO_ADJ;
+use tetrefine::io::{Facet, Plc};
 use tetrefine::tetgen::{refine, tetrahedralize, Options, TetgenError};
+use tetrefine::NO_ADJ;
 use tetrefine::{MeshStats, TetMesh};
 
 const EXAMPLE: &str = "meshes/tetgen_example.poly";
@@ -544,7 +544,7 @@ fn cli_bad_surfaces_fail_with_one_line_and_no_output() {
 /// one-line errors, never a crash of the process.
 #[test]
 fn outside_seeds_and_hostile_switches_are_refused_cleanly() {
-    use tetrefine::io::plc::Region;
+    use tetrefine::io::Region;
     for z in [2.0, 1e308] {
         let mut plc = cube_plc();
         plc.regions.push(Region {

@@ -71,7 +71,7 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use std::collections::{BTreeMap, HashMap, HashSet};
 use std::path::Path;
-use tetrefine::file::IoError;
+use tetrefine::io::IoError;
 
 /// One set of weights (see the module docs for the equations).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
@@ -232,7 +232,7 @@ pub struct WeightedConfig {
 impl WeightedConfig {
     /// Reads a configuration from a JSON file; errors name the file and line.
     pub fn from_json_file(path: &Path) -> Result<WeightedConfig, IoError> {
-        let bytes = tetrefine::file::read_bytes(path)?;
+        let bytes = tetrefine::io::read_bytes(path)?;
         serde_json::from_slice(&bytes).map_err(|e| {
             let line = Some(e.line()).filter(|&l| l > 0);
             IoError::decode(path, line, "invalid weights file", e)

@@ -11,13 +11,13 @@
 //! Readers return a [`SurfaceFile`]: the mesh plus the line of every face, so
 //! that [`load_surface`], which also validates manifoldness and orientation,
 //! can name the line of the offending face. Every writer goes through
-//! [`tetrefine::file::write_atomic`]: a failed write leaves no partial file.
+//! [`tetrefine::io::write_atomic`]: a failed write leaves no partial file.
 
 use super::polymesh::PolyMesh;
 use glam::DVec3;
 use std::io::Write;
 use std::path::Path;
-use tetrefine::file::IoError;
+use tetrefine::io::IoError;
 
 /// A mesh as read from a file, with the 1-based line of each face.
 #[derive(Clone, Debug, Default)]
@@ -114,7 +114,7 @@ pub fn write_surface(path: &Path, mesh: &PolyMesh) -> Result<(), IoError> {
 
 /// The file as UTF-8 text, or an error naming the file (and the first bad
 /// line).
-pub(crate) use tetrefine::file::read_text;
+pub(crate) use tetrefine::io::read_text;
 
 /// The extension of `path` in lower case (empty when there is none).
 pub(crate) fn lowercase_extension(path: &Path) -> String {

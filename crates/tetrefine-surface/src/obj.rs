@@ -12,7 +12,7 @@ use super::polymesh::PolyMesh;
 use glam::DVec3;
 use std::io::Write;
 use std::path::Path;
-use tetrefine::file::{write_atomic, IoError};
+use tetrefine::io::{write_atomic, IoError};
 
 /// Reads an `.obj` file.
 pub fn read(path: &Path) -> Result<SurfaceFile, IoError> {

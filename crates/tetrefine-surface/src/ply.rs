@@ -14,7 +14,7 @@ use super::polymesh::PolyMesh;
 use glam::DVec3;
 use std::io::Write;
 use std::path::Path;
-use tetrefine::file::{write_atomic, IoError};
+use tetrefine::io::{write_atomic, IoError};
 
 #[derive(Debug)]
 enum Prop {

@@ -5,7 +5,7 @@ use super::io::{write_counted_faces, write_xyz_lines};
 use super::polymesh::PolyMesh;
 use std::io::Write;
 use std::path::Path;
-use tetrefine::file::{write_atomic, IoError};
+use tetrefine::io::{write_atomic, IoError};
 
 /// Writes a legacy `.vtk` POLYDATA file.
 pub fn write(path: &Path, mesh: &PolyMesh) -> Result<(), IoError> {

@@ -6,8 +6,8 @@
 
 use super::polymesh::PolyMesh;
 use std::path::Path;
-use tetrefine::file::{write_atomic, IoError};
-use tetrefine::polyline::{write_cells, write_footer, write_header, write_points};
+use tetrefine::io::vtp::{write_cells, write_footer, write_header, write_points};
+use tetrefine::io::{write_atomic, IoError};
 
 /// Writes a `.vtp` file.
 pub fn write(path: &Path, mesh: &PolyMesh) -> Result<(), IoError> {

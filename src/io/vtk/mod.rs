@@ -33,7 +33,7 @@ mod read;
 mod write;
 mod xml;
 
-pub use read::{read, read_noted, read_tet_cell_array, TetCellArray};
+pub use read::{read_noted, read_tet_cell_array, TetCellArray};
 pub use write::{write_vtu, CellArray, VtuSummary};
 
 /// VTK's cell type of a linear tetrahedron.

@@ -9,12 +9,6 @@ use std::borrow::Cow;
 use std::collections::BTreeMap;
 use std::path::Path;
 
-/// Reads a `.vtu` file: its tetrahedra, boundary triangles, points and
-/// regions. Cells of other types are dropped ([`read_noted`] says which).
-pub fn read(path: &Path) -> Result<MeshData, IoError> {
-    read_noted(path).map(|(d, _)| d)
-}
-
 /// VTK's cell type of a linear triangle.
 const VTK_TRIANGLE: i64 = 5;
 

@@ -3,7 +3,7 @@
 
 use std::path::PathBuf;
 use std::time::Instant;
-use tetrefine::refine::bisect::bisect;
+use tetrefine::bisect;
 
 /// Arguments of `bisect`.
 #[derive(clap::Args)]

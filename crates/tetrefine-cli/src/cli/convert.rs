@@ -18,7 +18,7 @@ pub struct Args {
     pub fields_out: Option<PathBuf>,
     /// MSH variant of a `.msh` output: 2.2, 4.1 or 4.1-binary.
     #[arg(long, default_value = "4.1")]
-    pub msh_format: tetrefine::io::gmsh::MshFormat,
+    pub msh_format: tetrefine::io::MshFormat,
 }
 
 /// Runs `convert`.
@@ -27,7 +27,7 @@ pub fn run(a: Args) -> super::CliResult {
     let (mut mesh, mut meta) = super::load_with_meta(&a.input)?;
     if let Some(f) = &a.fields {
         mesh.compact();
-        tetrefine::io::fields::add_sol_fields(f, &mut meta, mesh.n_points(), mesh.n_tets())
+        tetrefine::io::add_sol_fields(f, &mut meta, mesh.n_points(), mesh.n_tets())
             .map_err(|e| e.to_string())?;
     }
     if a.fields_out.is_some() && !meta.point_fields.iter().any(|f| f.len() == mesh.n_points()) {
@@ -41,8 +41,7 @@ pub fn run(a: Args) -> super::CliResult {
     };
     super::write_mesh_with(&a.output, &mesh, &meta, &options)?;
     if let Some(f) = &a.fields_out {
-        tetrefine::io::fields::write_point_fields(f, &meta, mesh.n_points())
-            .map_err(|e| e.to_string())?;
+        tetrefine::io::write_point_fields(f, &meta, mesh.n_points()).map_err(|e| e.to_string())?;
     }
     Ok(())
 }

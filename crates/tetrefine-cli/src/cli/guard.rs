@@ -2,7 +2,7 @@
 //! memory would not fit (instead of the kernel's OOM killer), and
 //! selections that select nothing or cannot select anything.
 
-use tetrefine::refine::marking::MarkStrategy;
+use tetrefine::MarkStrategy;
 use tetrefine::TetMesh;
 
 /// Peak bytes per output tet of a √3 step: the README's measured 91 bytes

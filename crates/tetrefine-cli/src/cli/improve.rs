@@ -2,8 +2,8 @@
 //! boundary fixed — a mesh clean-up tool.
 
 use std::path::PathBuf;
-use tetrefine::improve::{improve, ImproveOptions};
 use tetrefine::MeshStats;
+use tetrefine::{improve, ImproveOptions};
 
 /// Arguments of `improve`.
 #[derive(clap::Args)]

@@ -39,7 +39,7 @@ pub fn run(_a: Args) -> super::CliResult {
 /// Runs `mesh`.
 #[cfg(feature = "tetgen")]
 pub fn run(a: Args) -> super::CliResult {
-    use tetrefine::io::plc::Plc;
+    use tetrefine::io::Plc;
     use tetrefine::tetgen::{tetrahedralize, Options};
     tetrefine::io::Format::for_writing(&a.output).map_err(|e| e.to_string())?;
     let opts = Options {

@@ -14,9 +14,9 @@ pub mod steps;
 pub mod surface;
 
 use std::path::Path;
-use tetrefine::io::vtk::{CellArray, VtuSummary};
-use tetrefine::report::histogram::{write_histogram as write_hist_file, HistogramFormat};
+use tetrefine::io::{CellArray, VtuSummary};
 use tetrefine::report::MeshStats;
+use tetrefine::report::{write_histogram as write_hist_file, HistogramFormat};
 use tetrefine::TetMesh;
 
 /// `println!` that never panics: a failed write (a closed pipe, a full
@@ -40,7 +40,7 @@ pub fn load(path: &std::path::Path) -> Result<tetrefine::TetMesh, String> {
 /// [`load`] with the file's side table (physical names, tag lists, fields).
 pub fn load_with_meta(
     path: &std::path::Path,
-) -> Result<(tetrefine::TetMesh, tetrefine::io::meta::MeshMeta), String> {
+) -> Result<(tetrefine::TetMesh, tetrefine::io::MeshMeta), String> {
     let (mesh, report, meta, notes) =
         tetrefine::io::load_mesh_with_meta_noted(path).map_err(|e| e.to_string())?;
     for n in notes {
@@ -91,7 +91,7 @@ pub fn write_refined(
     path: &Path,
     mesh: &mut TetMesh,
     extra: &[(&str, &TetValue<'_>)],
-    meta: &tetrefine::io::meta::MeshMeta,
+    meta: &tetrefine::io::MeshMeta,
     options: &tetrefine::io::WriteOptions,
 ) -> CliResult {
     mesh.compact();
@@ -121,7 +121,7 @@ pub fn write_refined(
         );
         let (valence, stats) = (MeshStats::vertex_valence(mesh), MeshStats::compute(mesh));
         let summary = vtu_summary(&valence, &stats);
-        tetrefine::io::vtk::write_vtu(path, mesh, Some(&summary), &cells).map_err(|e| e.to_string())
+        tetrefine::io::write_vtu(path, mesh, Some(&summary), &cells).map_err(|e| e.to_string())
     } else {
         tetrefine::io::write_mesh_with(path, mesh, meta, options).map_err(|e| e.to_string())
     }
@@ -149,7 +149,7 @@ pub fn write_mesh(path: &Path, mesh: &TetMesh) -> CliResult {
 pub fn write_mesh_with(
     path: &Path,
     mesh: &TetMesh,
-    meta: &tetrefine::io::meta::MeshMeta,
+    meta: &tetrefine::io::MeshMeta,
     options: &tetrefine::io::WriteOptions,
 ) -> CliResult {
     let is_vtu = tetrefine::io::Format::for_writing(path).map_err(|e| e.to_string())?
@@ -157,7 +157,7 @@ pub fn write_mesh_with(
     if is_vtu {
         let (valence, stats) = (MeshStats::vertex_valence(mesh), MeshStats::compute(mesh));
         let summary = vtu_summary(&valence, &stats);
-        tetrefine::io::vtk::write_vtu(path, mesh, Some(&summary), &[]).map_err(|e| e.to_string())
+        tetrefine::io::write_vtu(path, mesh, Some(&summary), &[]).map_err(|e| e.to_string())
     } else {
         tetrefine::io::write_mesh_with(path, mesh, meta, options).map_err(|e| e.to_string())
     }
@@ -166,8 +166,8 @@ pub fn write_mesh_with(
 /// Applies `--features auto|none|FILE` to a freshly loaded mesh and tells the
 /// user on stderr what it found.
 pub fn apply_feature_option(mesh: &mut TetMesh, spec: &str, angle_deg: f64) -> CliResult {
-    use tetrefine::io::edges::read_edge_list;
-    use tetrefine::refine::features::detect_features;
+    use tetrefine::detect_features;
+    use tetrefine::io::read_edge_list;
     match spec {
         "none" => mesh.clear_features(),
         "auto" => {
@@ -191,5 +191,5 @@ pub fn apply_feature_option(mesh: &mut TetMesh, spec: &str, angle_deg: f64) -> C
 
 /// Writes the feature edges of `mesh` as two-point polylines (.vtp or .csv).
 pub fn write_feature_lines(path: &Path, mesh: &TetMesh) -> CliResult {
-    tetrefine::polyline::write_feature_lines(path, mesh).map_err(|e| e.to_string())
+    tetrefine::write_feature_lines(path, mesh).map_err(|e| e.to_string())
 }

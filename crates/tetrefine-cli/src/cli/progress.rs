@@ -2,7 +2,7 @@
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::sync::Mutex;
-use tetrefine::refine::{Phase, Progress};
+use tetrefine::{Phase, Progress};
 
 /// A bar over all phases of all steps, with the running
 /// phase and its tet count as message, on stderr; hidden when stderr is not

@@ -1,9 +1,9 @@
 //! `tetrefine quality IN [--json] [--histogram FILE.csv|.svg|.png] [--bins N] [-o OUT]`.
 
 use std::path::{Path, PathBuf};
-use tetrefine::report::histogram::{write_histogram, HistogramFormat};
-use tetrefine::report::stats::DEFAULT_HIST_MAX_DEG;
+use tetrefine::report::DEFAULT_HIST_MAX_DEG;
 use tetrefine::report::{format_table, Histogram};
+use tetrefine::report::{write_histogram, HistogramFormat};
 use tetrefine::MeshStats;
 
 /// Most histogram bins accepted (0.0071° each over 0–71°); every parallel task
@@ -24,7 +24,7 @@ pub struct Args {
     #[arg(long, value_name = "FILE")]
     pub histogram: Option<PathBuf>,
     /// Number of equal histogram bins over 0–71° (71: bins of 1°; at most 10000).
-    #[arg(long, value_name = "N", default_value_t = tetrefine::report::stats::DEFAULT_BINS)]
+    #[arg(long, value_name = "N", default_value_t = tetrefine::report::DEFAULT_BINS)]
     pub bins: usize,
     /// Also write the mesh (format by extension; .vtu carries the quality arrays).
     #[arg(short = 'o', long = "output", value_name = "OUT")]

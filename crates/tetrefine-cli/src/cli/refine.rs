@@ -5,11 +5,11 @@ use super::progress::BarProgress;
 use super::steps::StepStats;
 use std::path::PathBuf;
 use std::time::Instant;
-use tetrefine::io::indicator::read_indicator;
-use tetrefine::refine::marking::{select, MarkStrategy};
-use tetrefine::refine::{locate_parents, refine_with, Phase, RefineOptions, Sqrt3Rule};
-use tetrefine::report::steps::{step_row, step_table_header};
+use tetrefine::io::read_indicator;
+use tetrefine::report::{step_row, step_table_header};
 use tetrefine::MeshStats;
+use tetrefine::{locate_parents, refine_with, Phase, RefineOptions, Sqrt3Rule};
+use tetrefine::{select, MarkStrategy};
 
 /// The `--stats` file: `{"steps": [input, step 1, …]}`.
 #[derive(serde::Serialize)]
@@ -106,7 +106,7 @@ pub struct Args {
     /// MSH variant of a `.msh` output: 2.2, 4.1 or 4.1-binary. Physical
     /// names and every physical tag of the input's entities are written back.
     #[arg(long, default_value = "4.1")]
-    pub msh_format: tetrefine::io::gmsh::MshFormat,
+    pub msh_format: tetrefine::io::MshFormat,
 }
 
 /// Where the optimize phase may act in adaptive refinement.
@@ -180,7 +180,7 @@ pub fn run(a: Args) -> super::CliResult {
         ));
     }
     if let Some(f) = &a.features_out {
-        tetrefine::polyline::PolylineFormat::of(f).map_err(|e| e.to_string())?;
+        tetrefine::PolylineFormat::of(f).map_err(|e| e.to_string())?;
     }
     let strategy = mark_strategy(&a)?;
     let (mut input, meta) = super::load_with_meta(&a.input)?;

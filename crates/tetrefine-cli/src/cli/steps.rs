@@ -2,8 +2,8 @@
 //! the input): a mesh's statistics joined with what the step did.
 
 use serde::Serialize;
-use tetrefine::refine::{PhaseReport, StepReport};
 use tetrefine::MeshStats;
+use tetrefine::{PhaseReport, StepReport};
 
 /// One entry of `--stats`: the quality JSON of the mesh after the step, plus
 /// the step's phases and wall time (empty / 0 for the input entry).

@@ -5,9 +5,9 @@ use glam::DVec3;
 use std::collections::HashSet;
 use std::path::{Path, PathBuf};
 use std::process::Command;
+use tetrefine::contains;
 use tetrefine::io::load_mesh;
-use tetrefine::io::vtk::read_tet_cell_array;
-use tetrefine::refine::parents::contains;
+use tetrefine::io::read_tet_cell_array;
 use tetrefine::{MeshStats, TetMesh};
 
 fn bin() -> Command {

@@ -7,17 +7,14 @@
 
 use std::collections::{HashMap, HashSet};
 use std::path::{Path, PathBuf};
+use tetrefine::detect_features;
 use tetrefine::geom::tet_volume;
 use tetrefine::io::load_mesh;
-use tetrefine::mesh::edge_key;
-use tetrefine::ops::{
-    flip23::{flip23, flip23_valid},
-    flip32::flip32,
-};
-use tetrefine::refine::bisect::{bisect, bisect_steps};
-use tetrefine::refine::features::detect_features;
+use tetrefine::ops::{flip23, flip23_valid, flip32};
+use tetrefine::topo::edge_key;
 use tetrefine::topo::TET_EDGES;
 use tetrefine::TetMesh;
+use tetrefine::{bisect, bisect_steps};
 
 fn load(name: &str) -> TetMesh {
     load_mesh(&crate::support::path("meshes").join(name))

@@ -8,9 +8,9 @@
 use crate::support;
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
-use tetrefine::io::meta::MeshMeta;
+use tetrefine::io::MeshMeta;
 use tetrefine::io::{load_mesh_with_meta, read_mesh_with_meta};
-use tetrefine::mesh::MeshData;
+use tetrefine::MeshData;
 
 /// A file of `tests/data`.
 fn data(name: &str) -> PathBuf {

@@ -58,7 +58,7 @@ fn fields_from_a_sol_go_out_again_and_a_wrong_count_is_an_error_at_its_line() {
         solb.to_str().unwrap(),
     ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let back = tetrefine::io::meshb::read_sol(&solb).unwrap();
+    let back = tetrefine::io::read_sol(&solb).unwrap();
     assert_eq!(back.entries, pts.len());
     for (i, p) in pts.iter().enumerate() {
         assert_eq!(

@@ -2,7 +2,7 @@
 //! `--stop-after`, the `.vtu` arrays and `--features-out`.
 
 use tetrefine::io::load_mesh;
-use tetrefine::io::vtk::read_tet_cell_array;
+use tetrefine::io::read_tet_cell_array;
 
 fn run(args: &[&str]) -> std::process::Output {
     let o = crate::tetrefine_command().args(args).output().unwrap();

@@ -5,7 +5,7 @@
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
-use tetrefine::io::plc::{Facet, Plc, PlcError, Region};
+use tetrefine::io::{Facet, Plc, PlcError, Region};
 
 fn meshes() -> PathBuf {
     crate::support::root().join("meshes")
@@ -128,7 +128,7 @@ fn the_issue_case_names_the_array_on_the_command_line_and_writes_nothing() {
 #[test]
 fn a_mixed_cell_vtu_keeps_tets_and_triangles_and_says_what_it_dropped() {
     let vtu = meshes().join("mmg_cube.vtu");
-    let (data, note) = tetrefine::io::vtk::read_noted(&vtu).unwrap();
+    let (data, note) = tetrefine::io::read_vtu_noted(&vtu).unwrap();
     // The same mesh from the Medit file (an independent reader).
     let medit = tetrefine::io::read_mesh(&meshes().join("mmg_cube.mesh")).unwrap();
     assert_eq!(data.tets.len(), medit.tets.len());
@@ -373,7 +373,7 @@ fn sigterm_during_a_write_leaves_no_temporary_file() {
     let dir = tempfile::tempdir().unwrap();
     let input = dir.path().join("cube.mesh");
     // 30^3 * 6 = 162,000 tets: writing the .vtu takes a noticeable time.
-    let data = tetrefine::mesh::generate::cube_grid(30);
+    let data = tetrefine::cube_grid(30);
     let (mesh, _) = tetrefine::TetMesh::from_data(&data).unwrap();
     tetrefine::io::write_mesh(&input, &mesh).unwrap();
     let out = dir.path().join("o.vtu");

@@ -529,7 +529,7 @@ pub fn run_case(kind: Kind, path: &Path, mesh: &tetrefine::TetMesh, names: &[&st
                 m.check().map_err(|e| format!("CHECK: {e}"))?;
             }
             Kind::Indicator => {
-                let v = tetrefine::io::indicator::read_indicator(path.to_str().unwrap(), mesh)
+                let v = tetrefine::io::read_indicator(path.to_str().unwrap(), mesh)
                     .map_err(|e| e.to_string())?;
                 if v.len() != mesh.n_tets() {
                     return Err(format!(
@@ -544,7 +544,7 @@ pub fn run_case(kind: Kind, path: &Path, mesh: &tetrefine::TetMesh, names: &[&st
                 s.validate().map_err(|e| format!("CHECK: {e}"))?;
             }
             Kind::Plc => {
-                let p = tetrefine::io::plc::Plc::read(path).map_err(|e| e.to_string())?;
+                let p = tetrefine::io::Plc::read(path).map_err(|e| e.to_string())?;
                 // Analysis may refuse the surface; that is not the reader's error.
                 let _ = p.analyze();
             }

@@ -58,12 +58,12 @@ mod linalg;
 use super::error::SurfaceError;
 use glam::DVec3;
 use linalg::{mat_mul, restricted_frobenius, row_times, solve4};
+use tetrefine::SplitMix64;
 /// The attractor's writers: the core's point and polyline files.
-pub use tetrefine::polyline::{
+pub use tetrefine::{
     write_points_csv, write_points_vtp, write_polylines, write_polylines_csv, write_polylines_vtp,
     PolylineFormat,
 };
-use tetrefine::rng::SplitMix64;
 
 /// Which subdivision scheme an [`Ifs`] comes from.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -6,8 +6,8 @@
 use glam::DVec3;
 use std::collections::HashSet;
 use tetrefine::io::load_mesh;
-use tetrefine::refine::{refine_step, RefineOptions, Sqrt3Rule};
 use tetrefine::TetMesh;
+use tetrefine::{refine_step, RefineOptions, Sqrt3Rule};
 use tetrefine_surface::sqrt3::{sqrt3, Sqrt3Options};
 use tetrefine_surface::PolyMesh;
 
