@@ -52,6 +52,10 @@ fn min_norm_in_hull(g: &[DVec3]) -> DVec3 {
         }
         let d = g[bi] - x;
         let dd = d.length_squared();
+        // The hull point only picks a search direction; the thresholds end
+        // the iteration when it no longer moves in double precision. Any
+        // direction is safe, because every trial position is judged again
+        // below by its exact ball qualities and orientation.
         if dd < 1e-30 {
             break;
         }
@@ -104,6 +108,10 @@ pub fn optimize_position_in(
         return None;
     }
     scale /= n as f64;
+    // Central differences with h = 1e-6 of the mean edge length: truncation
+    // error O(h²) ≈ 1e-12 and rounding ≈ ε/h ≈ 1e-10, relative — ample for a
+    // search direction. Validity never rests on the gradient: a move is kept
+    // only if the recomputed qualities rise and the ball stays positive.
     let h = 1e-6 * scale;
     let mut x = x0;
     qs.clear();
@@ -130,6 +138,7 @@ pub fn optimize_position_in(
         }
         let d = min_norm_in_hull(&grads);
         let dn = d.length();
+        // Below the gradient's own error (about 1e-10 relative, see `h`).
         if dn < 1e-12 {
             break; // stationary: no direction raises all active tets
         }

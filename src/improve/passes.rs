@@ -428,6 +428,9 @@ fn judge_ring(
         .map(|&u| tr.tq[u as usize])
         .fold(f64::INFINITY, f64::min);
     canonicalize_ring(ring);
+    // Strictly better by more than the rounding of `tet_min_sine` (a few
+    // ulps of a value ≤ 1), so that a retriangulation of equal quality is
+    // never taken and passes cannot cycle between two of them.
     let bar = worst + 1e-12;
     let tri = best_ring_triangulation_above(mesh, ring, bar, &mut s.dp);
     (tri.quality > bar).then_some(tri)

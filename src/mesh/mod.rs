@@ -131,6 +131,13 @@ impl TetMesh {
 
     // ----- accessors (each asserts its id, as geogram does) --------------------
 
+    /// Debug check of a tet id: in range and, for `live`, not a dead slot.
+    #[inline]
+    fn debug_check_tet(&self, t: u32, live: bool) {
+        debug_assert!((t as usize) < self.tets.len(), "tet {t} out of range");
+        debug_assert!(!live || self.tets[t as usize][0] != DEAD, "tet {t} is dead");
+    }
+
     /// Coordinates of point `v`.
     #[inline]
     pub fn point(&self, v: u32) -> DVec3 {
@@ -148,6 +155,8 @@ impl TetMesh {
     /// [`ball_stays_positive`]).
     #[inline]
     pub fn set_point(&mut self, v: u32, p: DVec3) {
+        debug_assert!((v as usize) < self.points.len(), "point {v} out of range");
+        debug_assert!(p.is_finite(), "point {v} moved to {p}");
         self.points[v as usize] = p;
     }
 
@@ -171,9 +180,8 @@ impl TetMesh {
     /// The four vertex ids of tet `t`.
     #[inline]
     pub fn tet(&self, t: u32) -> [u32; 4] {
-        let v = self.tets[t as usize];
-        debug_assert!(v[0] != DEAD, "tet {t} is dead");
-        v
+        self.debug_check_tet(t, true);
+        self.tets[t as usize]
     }
 
     /// All tet slots (dead slots hold [`DEAD`]).
@@ -197,7 +205,7 @@ impl TetMesh {
     /// Adjacency of tet `t` (`4*t'+j` or [`NO_ADJ`] per face).
     #[inline]
     pub fn adj(&self, t: u32) -> [u32; 4] {
-        debug_assert!(self.is_alive(t), "tet {t} is dead");
+        self.debug_check_tet(t, true);
         self.adj[t as usize]
     }
 
@@ -205,42 +213,49 @@ impl TetMesh {
     /// reused, so a queue that stored `(t, generation)` can tell a stale entry.
     #[inline]
     pub fn generation(&self, t: u32) -> u32 {
+        self.debug_check_tet(t, false);
         self.generation[t as usize]
     }
 
     /// Region id of tet `t`.
     #[inline]
     pub fn region(&self, t: u32) -> i32 {
+        self.debug_check_tet(t, true);
         self.region[t as usize]
     }
 
     /// Sets the region id of tet `t`.
     #[inline]
     pub fn set_region(&mut self, t: u32, r: i32) {
+        self.debug_check_tet(t, true);
         self.region[t as usize] = r;
     }
 
     /// Refinement level of tet `t` (0 for input tets).
     #[inline]
     pub fn level(&self, t: u32) -> u8 {
+        self.debug_check_tet(t, true);
         self.level[t as usize]
     }
 
     /// Sets the refinement level of tet `t`.
     #[inline]
     pub fn set_level(&mut self, t: u32, l: u8) {
+        self.debug_check_tet(t, true);
         self.level[t as usize] = l;
     }
 
     /// Input tet that tet `t` descends from (its own id for input tets).
     #[inline]
     pub fn parent(&self, t: u32) -> u32 {
+        self.debug_check_tet(t, true);
         self.parent[t as usize]
     }
 
     /// Sets the input tet that tet `t` descends from.
     #[inline]
     pub fn set_parent(&mut self, t: u32, p: u32) {
+        self.debug_check_tet(t, true);
         self.parent[t as usize] = p;
     }
 
@@ -255,6 +270,8 @@ impl TetMesh {
     /// Whether face `f` of tet `t` is on the boundary.
     #[inline]
     pub fn is_boundary_face(&self, t: u32, f: usize) -> bool {
+        self.debug_check_tet(t, true);
+        debug_assert!(f < 4, "face {f} of a tet");
         self.adj[t as usize][f] == NO_ADJ
     }
 

@@ -321,8 +321,9 @@ fn bisect_dense(m: &TetMesh) -> Result<TetMesh, BisectError> {
                 } else {
                     let w = tets[min as usize];
                     let [i, j] = TET_EDGES[e];
-                    let li = w.iter().position(|&x| x == v[i]).unwrap_or(0);
-                    let lj = w.iter().position(|&x| x == v[j]).unwrap_or(0);
+                    let owns = "the edge's owner tet is in its ring, so it holds both ends";
+                    let li = w.iter().position(|&x| x == v[i]).expect(owns);
+                    let lj = w.iter().position(|&x| x == v[j]).expect(owns);
                     *o = 8 * min + EDGE_INDEX[li][lj] as u32;
                 }
             }
@@ -413,7 +414,9 @@ fn bisect_dense(m: &TetMesh) -> Result<TetMesh, BisectError> {
                                     4
                                 } else {
                                     let x = v[sub as usize];
-                                    w.iter().position(|&y| y == x).unwrap_or(0)
+                                    w.iter()
+                                        .position(|&y| y == x)
+                                        .expect("the tet across a face holds the face's vertices")
                                 };
                                 let (c2, f2) = tpl[(flags[u] >> 6) as usize].on_face[g][s2];
                                 4 * (8 * u as u32 + c2 as u32) + f2 as u32
@@ -458,7 +461,7 @@ fn bisect_dense(m: &TetMesh) -> Result<TetMesh, BisectError> {
                 let local = tets[t as usize]
                     .iter()
                     .position(|&y| y == x as u32)
-                    .unwrap_or(0);
+                    .expect("v2t names a tet that holds the vertex");
                 8 * t + local as u32
             }
         })
@@ -473,8 +476,9 @@ fn bisect_dense(m: &TetMesh) -> Result<TetMesh, BisectError> {
     // of its vertices, and read the midpoints from that tet's edge owners.
     let mid_in = |t: u32, a: u32, b: u32| -> u32 {
         let w = tets[t as usize];
-        let la = w.iter().position(|&y| y == a).unwrap_or(0);
-        let lb = w.iter().position(|&y| y == b).unwrap_or(0);
+        let holds = "the tet found around a tagged edge or face holds its vertices";
+        let la = w.iter().position(|&y| y == a).expect(holds);
+        let lb = w.iter().position(|&y| y == b).expect(holds);
         mid_of(owners[t as usize][EDGE_INDEX[la][lb] as usize])
     };
     let find_tet = |buf: &mut Vec<u32>, a: u32, others: &[u32]| -> Option<u32> {
