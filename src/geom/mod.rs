@@ -1,8 +1,10 @@
 //! Geometry: exact orientation predicates and tetrahedron quality measures.
 
+pub mod exact;
 pub mod predicates;
 pub mod quality;
 
+pub use exact::{orient2d_exact, orient3d_exact};
 pub use predicates::{
     all_positive, is_positive, orient3d, orient3d_sign, positive_in_doubles, Orientation,
 };

@@ -22,6 +22,7 @@
 
 mod error;
 mod geometry;
+mod locate;
 mod validate;
 mod volume;
 
