@@ -37,13 +37,13 @@ pub fn orient3d_exact(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> i8 {
 /// [`orient3d_exact`] in big-integer arithmetic, on `a, b, c, d` flattened.
 fn big3(coords: &[f64]) -> i8 {
     let [ax, ay, az, bx, by, bz, cx, cy, cz, dx, dy, dz] = integers(coords);
-    let (bax, bay, baz) = (bx.sub(&ax), by.sub(&ay), bz.sub(&az));
+    let (u_x, u_y, u_z) = (bx.sub(&ax), by.sub(&ay), bz.sub(&az));
     let (cax, cay, caz) = (cx.sub(&ax), cy.sub(&ay), cz.sub(&az));
     let (dax, day, daz) = (dx.sub(&ax), dy.sub(&ay), dz.sub(&az));
     let m1 = cay.mul(&daz).sub(&caz.mul(&day));
     let m2 = cax.mul(&daz).sub(&caz.mul(&dax));
     let m3 = cax.mul(&day).sub(&cay.mul(&dax));
-    bax.mul(&m1).sub(&bay.mul(&m2)).add(&baz.mul(&m3)).sign()
+    u_x.mul(&m1).sub(&u_y.mul(&m2)).add(&u_z.mul(&m3)).sign()
 }
 
 /// Sign of `(b − a) × (c − a)` (counter-clockwise positive), exactly.
@@ -57,9 +57,9 @@ pub fn orient2d_exact(a: [f64; 2], b: [f64; 2], c: [f64; 2]) -> i8 {
         return sign(robust::orient2d(k(a), k(b), k(c)));
     }
     let [ax, ay, bx, by, cx, cy] = integers(&coords);
-    let (bax, bay) = (bx.sub(&ax), by.sub(&ay));
+    let (u_x, u_y) = (bx.sub(&ax), by.sub(&ay));
     let (cax, cay) = (cx.sub(&ax), cy.sub(&ay));
-    bax.mul(&cay).sub(&bay.mul(&cax)).sign()
+    u_x.mul(&cay).sub(&u_y.mul(&cax)).sign()
 }
 
 fn sign(v: f64) -> i8 {

@@ -336,6 +336,27 @@ fn a_failed_write_to_standard_output_fails_the_command() {
     assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
     assert!(stderr(&o).contains("standard output"), "{}", stderr(&o));
     assert!(!out.exists(), "no output after a failed command");
+    // `>&-`: standard output closed when the command starts.
+    let o = Command::new("sh")
+        .arg("-c")
+        .arg(format!(
+            "'{}' quality '{}' --json -o '{}' >&-",
+            env!("CARGO_BIN_EXE_tetrefine"),
+            tripod.display(),
+            out.display()
+        ))
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(stderr(&o).contains("standard output"), "{}", stderr(&o));
+    assert!(!out.exists(), "no output after a failed command");
+    // `> /dev/null` is a place to write to, not an error.
+    let o = Command::new(env!("CARGO_BIN_EXE_tetrefine"))
+        .args(["quality", tripod.to_str().unwrap(), "--json"])
+        .stdout(std::process::Stdio::null())
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
 }
 
 #[test]
@@ -426,7 +447,7 @@ fn degenerate_and_empty_selections_and_steps_zero_are_errors() {
         (&["--box", "1,1,1,0,0,0"], "inverted along x"),
         (&["--mark", "box:-50,50,-50,50,-50,50"], "inverted along y"),
         (&["--sphere", "0,0,0,0"], "radius"),
-        (&["--mark", "region:1,99"], "no region 99"),
+        (&["--mark", "region:0,99"], "no region 99"),
         (&["--sphere", "0,0,0,-1"], "radius"),
         (&["--region", "99"], "no region 99"),
         (&["--sphere", "1e6,1e6,1e6,1"], "selects none"),
@@ -953,4 +974,45 @@ fn the_memory_guard_checks_each_step_and_bisect_and_improve() {
         "1",
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
+}
+
+/// Issue 21: `surface` steps are guarded by memory as `refine` is: a run
+/// whose projected output would not fit `--max-memory` is refused before
+/// any work, with no output.
+#[test]
+fn surface_steps_are_held_against_the_memory_budget() {
+    let dir = tempfile::tempdir().unwrap();
+    let tet = dir.path().join("tet.obj");
+    std::fs::write(
+        &tet,
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 2 3 4\nf 1 4 3\n",
+    )
+    .unwrap();
+    let out = dir.path().join("o.obj");
+    let run = |steps: &str, mem: &str| {
+        tetrefine(&[
+            "surface",
+            "loop",
+            tet.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+            "--steps",
+            steps,
+            "--max-memory",
+            mem,
+        ])
+    };
+    // 12 sides × 4⁵ = 12,288 projected faces at 300 bytes: 3.7 MB.
+    let o = run("6", "1M");
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("6 steps would not fit in memory")
+            && stderr(&o).contains("--max-memory"),
+        "{}",
+        stderr(&o)
+    );
+    assert!(!out.exists());
+    let o = run("3", "1M");
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(out.exists());
 }
