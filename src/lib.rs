@@ -75,8 +75,8 @@ pub use refine::features::detect_features;
 pub use refine::marking::{doerfler_count, fraction_count, ranking, select, MarkStrategy};
 pub use refine::parents::{contains, walk_to};
 pub use refine::{
-    locate_parents, refine, refine_step, refine_step_with_progress, refine_with, NoProgress, Phase,
-    PhaseReport, Progress, RefineOptions, StepReport,
+    locate_parents, refine, refine_step, refine_step_with_progress, refine_with, refine_with_guard,
+    NoProgress, Phase, PhaseReport, Progress, RefineOptions, StepReport,
 };
 pub use report::{format_table, write_histogram, MeshStats};
 pub use rng::SplitMix64;

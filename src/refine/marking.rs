@@ -14,7 +14,7 @@
 //! | `max:γ`, 0 ≤ γ ≤ 1 | η_t ≥ γ·max η (the maximum strategy of Babuška and Rheinboldt, 1978) |
 //! | `threshold:X` | η_t ≥ X |
 //! | `region:ID[,ID…]` | tets whose region is one of the ids |
-//! | `box:x0,y0,z0,x1,y1,z1` | tets whose centroid lies in the closed axis-aligned box with these opposite corners (in any order) |
+//! | `box:x0,y0,z0,x1,y1,z1` | tets whose centroid lies in the closed axis-aligned box from the lower corner `x0,y0,z0` to the upper `x1,y1,z1` (an inverted box, `x0 > x1`, is an error) |
 //! | `sphere:x,y,z,r`, r > 0 | tets whose centroid lies in the closed ball |
 //! | `A+B+…` | the union of the selections |
 //!
@@ -199,11 +199,19 @@ fn parse_one(spec: &str) -> Result<MarkStrategy, String> {
         }
         "box" => {
             let v = numbers(s, body, 6, "box:x0,y0,z0,x1,y1,z1")?;
-            let a = DVec3::new(v[0], v[1], v[2]);
-            let b = DVec3::new(v[3], v[4], v[5]);
+            // The lower corner comes first: swapped corners are far more
+            // likely a typo than a request, so an inverted box is an error.
+            for (axis, name) in ["x", "y", "z"].iter().enumerate() {
+                let (lo, hi) = (v[axis], v[axis + 3]);
+                if lo > hi {
+                    return Err(format!(
+                        "'{s}': the box is inverted along {name} ({name}0 = {lo} > {name}1 = {hi}); box:x0,y0,z0,x1,y1,z1 needs the lower corner first"
+                    ));
+                }
+            }
             Ok(MarkStrategy::Box {
-                min: a.min(b),
-                max: a.max(b),
+                min: DVec3::new(v[0], v[1], v[2]),
+                max: DVec3::new(v[3], v[4], v[5]),
             })
         }
         "sphere" => {

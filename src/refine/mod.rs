@@ -24,7 +24,7 @@ pub mod parents;
 pub mod step;
 
 pub use parents::locate_parents;
-pub use step::{refine, refine_step, refine_step_with_progress, refine_with};
+pub use step::{refine, refine_step, refine_step_with_progress, refine_with, refine_with_guard};
 
 /// Progress callbacks for long phases (the CLI draws bars with them).
 /// Every method has a no-op default.

@@ -35,16 +35,40 @@ pub fn refine_with(
     steps: usize,
     opts: &RefineOptions,
     progress: &dyn Progress,
-    mut on_step: impl FnMut(usize, &TetMesh, StepReport),
+    on_step: impl FnMut(usize, &TetMesh, StepReport),
 ) {
+    let never = |_: usize, _: &TetMesh, _: u64| Ok::<(), std::convert::Infallible>(());
+    let Ok(()) = refine_with_guard(mesh, steps, opts, progress, never, on_step);
+}
+
+/// [`refine_with`] with a guard before every step: `before_step(step, mesh,
+/// split)` sees the mesh and how many of its tets the step will split, and
+/// an `Err` stops the refinement there (the mesh is as the previous step
+/// left it) and is returned — e.g. a step whose memory would not fit.
+pub fn refine_with_guard<E>(
+    mesh: &mut TetMesh,
+    steps: usize,
+    opts: &RefineOptions,
+    progress: &dyn Progress,
+    mut before_step: impl FnMut(usize, &TetMesh, u64) -> Result<(), E>,
+    mut on_step: impl FnMut(usize, &TetMesh, StepReport),
+) -> Result<(), E> {
     let mut step_opts = opts.clone();
     for s in 1..=steps {
         if s > 1 && opts.selection.is_some() {
             step_opts.selection = Some(descendants_of_last_step(mesh, s - 1));
         }
+        let split = match &step_opts.selection {
+            Some(sel) => (0..mesh.n_tet_slots() as u32)
+                .filter(|&t| mesh.is_alive(t) && sel.get(t as usize).copied().unwrap_or(false))
+                .count(),
+            None => mesh.n_tets(),
+        };
+        before_step(s, mesh, split as u64)?;
         let report = refine_step_with_progress(mesh, s, &step_opts, progress);
         on_step(s, mesh, report);
     }
+    Ok(())
 }
 
 /// Per tet slot: was it refined in step `step` (its level is `step`)? With a

@@ -260,10 +260,9 @@ fn region_box_and_sphere_follow_the_centroids() {
     }
     assert_eq!(chosen(&sel).len(), 2 * 3 * 2 * 6);
 
-    // A box given by its corners in any order; the closed box.
-    let boxes: [[f64; 6]; 3] = [
+    // A box from its lower to its upper corner; the closed box.
+    let boxes: [[f64; 6]; 2] = [
         [0.5, 0.2, 0.0, 2.5, 2.0, 1.0],
-        [2.5, 2.0, 1.0, 0.5, 0.2, 0.0],
         [1.25, 0.0, 0.0, 1.75, 3.0, 2.0],
     ];
     for b in boxes {
@@ -379,6 +378,9 @@ fn parser_errors_say_what_is_needed() {
         ("region:a", "integer region ids"),
         ("box:0,0,0,1,1", "needs 6 comma-separated numbers"),
         ("box:0,0,0,1,1,nan", "not a finite number"),
+        ("box:1,1,1,0,0,0", "inverted along x (x0 = 1 > x1 = 0)"),
+        ("box:0,1,0,1,0,1", "inverted along y"),
+        ("box:0,0,2,1,1,-2", "inverted along z"),
         ("sphere:0,0,0,0", "radius r > 0"),
         ("sphere:0,0,0", "needs 4 comma-separated numbers"),
         ("bisect:0.3", "unknown marking strategy 'bisect'"),

@@ -613,3 +613,94 @@ fn outside_seeds_and_hostile_switches_are_refused_cleanly() {
         assert!(!out.exists());
     }
 }
+
+/// Issue 21: a seed inside the bounding box but outside the surface, and
+/// one a single ulp outside a facet, are refused by the exact test before
+/// TetGen sees them; a seed a single ulp inside meshes.
+#[test]
+fn seeds_are_located_exactly_before_tetgen() {
+    use tetrefine::io::Region;
+    let seed = |p: [f64; 3]| {
+        let mut plc = cube_plc();
+        plc.regions.push(Region {
+            point: p,
+            attribute: 3,
+            max_volume: None,
+        });
+        tetrahedralize(&plc, &Options::default())
+    };
+    let up = f64::from_bits(1f64.to_bits() + 1);
+    let down = f64::from_bits(1f64.to_bits() - 1);
+    let e = seed([0.5, up, 0.5]).unwrap_err();
+    assert!(e.to_string().contains("outside the surface"), "{e}");
+    let m = seed([0.5, down, 0.5]).unwrap();
+    assert!(m.tet_ids().all(|t| m.region(t) == 3));
+    // Two cubes side by side with a gap: a seed in the gap.
+    let mut two = cube_plc();
+    let n = two.points.len() as u32;
+    two.points
+        .extend(cube_points().iter().map(|p| [p[0] + 2.0, p[1], p[2]]));
+    for (m, q) in CUBE_QUADS.iter().enumerate() {
+        two.facets.push(Facet {
+            polygons: vec![q.iter().map(|&v| v + n).collect()],
+            holes: vec![],
+            marker: m as i32 + 7,
+        });
+    }
+    two.regions.push(Region {
+        point: [1.5, 0.5, 0.5],
+        attribute: 3,
+        max_volume: None,
+    });
+    let e = tetrahedralize(&two, &Options::default()).unwrap_err();
+    assert!(e.to_string().contains("outside the surface"), "{e}");
+}
+
+/// Issue 21: `mesh --time-limit` stops a TetGen run that takes too long,
+/// with a one-line error naming the limit and no output; the default
+/// limit lets a normal run finish.
+#[test]
+fn mesh_time_limit_stops_a_long_tetgen_run_cleanly() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("o.mesh");
+    let input = support::root().join(EXAMPLE);
+    // About five million tets: many seconds of TetGen on any machine.
+    let t0 = std::time::Instant::now();
+    let o = tetrefine(&[
+        "mesh",
+        input.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--switches",
+        "a0.00002",
+        "--time-limit",
+        "0.5",
+    ]);
+    let took = t0.elapsed().as_secs_f64();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("--time-limit") && err.contains("0.5 s"),
+        "{err}"
+    );
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(o.stdout.is_empty());
+    assert!(!out.exists());
+    let left: Vec<_> = std::fs::read_dir(dir.path()).unwrap().collect();
+    assert!(left.is_empty(), "{left:?}");
+    assert!(took < 20.0, "{took} s");
+    for bad in ["-1", "nan", "inf"] {
+        let o = tetrefine(&[
+            "mesh",
+            input.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+            "--time-limit",
+            bad,
+        ]);
+        assert_eq!(o.status.code(), Some(1), "{bad}");
+        assert!(String::from_utf8_lossy(&o.stderr).contains("--time-limit"));
+    }
+    let o = tetrefine(&["mesh", input.to_str().unwrap(), "-o", out.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+}

@@ -205,7 +205,7 @@ pub(super) enum Ray {
     /// The ray grazes an edge or a plane: try another direction.
     Degenerate,
     /// The origin lies on this piece.
-    OnPiece(usize),
+    OnPiece,
 }
 
 /// The smallest loop of facet `g` that contains the 2-D point `p`.

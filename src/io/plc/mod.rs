@@ -22,6 +22,7 @@
 
 mod error;
 mod geometry;
+mod locate;
 mod validate;
 mod volume;
 
@@ -111,8 +112,9 @@ impl Plc {
     /// shell with a positive volume integral is the outer boundary of a
     /// bounded cell; a negative one is the boundary of a cavity seen from the
     /// cell around it, which a ray cast from the shell finds. A cell's
-    /// volume is the sum over its shells. Hole seeds are located by ray
-    /// casting as well, and their cells are left out.
+    /// volume is the sum over its shells. Hole and region seeds are then
+    /// located exactly (crossing parity with exact orientation signs, see
+    /// `locate.rs`); the cells of hole seeds are left out.
     pub fn enclosed_volume(&self) -> Result<f64, PlcError> {
         Ok(self.analyze()?.enclosed)
     }

@@ -226,3 +226,69 @@ fn merging_coincident_points_renumbers_facets() {
     assert_eq!(p.points.len(), 8);
     assert!((p.enclosed_volume().unwrap() - 1.0).abs() < 1e-14);
 }
+
+/// `plc` with one region seed at `x`.
+fn seeded(mut plc: Plc, x: [f64; 3]) -> Plc {
+    plc.regions = vec![Region {
+        point: x,
+        attribute: 7,
+        max_volume: None,
+    }];
+    plc
+}
+
+/// Issue 21: a seed outside every region is refused by an exact test, one
+/// ulp from the surface and at every scale; a seed inside is never refused.
+#[test]
+fn seeds_are_located_exactly() {
+    let outside = |p: &Plc| matches!(p.validate(), Err(PlcError::SeedOutside { .. }));
+    // The cube of the issue: a seed at z = 2 and at y = 1e308.
+    assert!(outside(&seeded(unit_cube(), [0.5, 0.5, 2.0])));
+    assert!(outside(&seeded(unit_cube(), [0.5, 1e308, 0.5])));
+    for s in [1.0, 1e300, 1e-300, 3.0e-10] {
+        // Two boxes [0, s]³ and [2s, 3s] × [0, s]²: the gap between them is
+        // inside the bounding box but outside the surface.
+        let mut two = Plc::default();
+        add_box(&mut two, [0.0; 3], [s; 3]);
+        add_box(&mut two, [2.0 * s, 0.0, 0.0], [3.0 * s, s, s]);
+        let h = 0.5 * s;
+        assert!(outside(&seeded(two.clone(), [1.5 * s, h, h])), "{s}");
+        let up = f64::from_bits(s.to_bits() + 1);
+        let down = f64::from_bits(s.to_bits() - 1);
+        assert!(
+            outside(&seeded(two.clone(), [up, h, h])),
+            "{s}: one ulp outside"
+        );
+        seeded(two.clone(), [down, h, h])
+            .validate()
+            .unwrap_or_else(|e| panic!("{s}: one ulp inside: {e}"));
+        assert!(
+            matches!(
+                seeded(two.clone(), [s, h, h]).validate(),
+                Err(PlcError::SeedOnFacet { .. })
+            ),
+            "{s}: on the facet"
+        );
+        // A seed in the second box, and one that moves off its corner edge.
+        seeded(two.clone(), [2.5 * s, h, h]).validate().unwrap();
+        let edge = f64::from_bits((2.0 * s).to_bits() - 1);
+        assert!(outside(&seeded(two.clone(), [edge, up, h])), "{s}");
+    }
+    // A unit cube and coordinates of 1e-310 (subnormal): the adaptive
+    // predicate's products underflow there, the exact test does not.
+    seeded(unit_cube(), [1e-310, 0.5, 0.5]).validate().unwrap();
+    seeded(unit_cube(), [1e-310, 1e-310, 1e-310])
+        .validate()
+        .unwrap();
+    assert!(outside(&seeded(unit_cube(), [-1e-310, 0.5, 0.5])));
+    // Holes are located the same way: a seed in the emptied cell is refused.
+    let mut nested = unit_cube();
+    add_box(&mut nested, [0.25; 3], [0.75; 3]);
+    nested.holes = vec![[0.5; 3]];
+    assert!(matches!(
+        seeded(nested.clone(), [0.5, 0.5, 0.6]).validate(),
+        Err(PlcError::SeedInHole { .. })
+    ));
+    let below = f64::from_bits(0.25f64.to_bits() - 1);
+    seeded(nested, [0.5, 0.5, below]).validate().unwrap();
+}

@@ -14,10 +14,6 @@ pub(super) struct Analysis {
     pub(super) center: DVec3,
     pub(super) facets: Vec<FacetGeom>,
     pub(super) pieces: Vec<Piece>,
-    /// The bounding box of the surface's points (input coordinates).
-    pub(super) lo: DVec3,
-    /// Its largest corner.
-    pub(super) hi: DVec3,
     /// Distance tolerance for degenerate ray hits.
     pub(super) tol: f64,
 }
@@ -74,22 +70,22 @@ impl Analysis {
         if let Some(s) = scale_of(plc) {
             // Checked in exactly scaled coordinates; volumes scaled back (a
             // volume beyond the doubles' range becomes infinite).
-            let mut v = Analysis::run_unscaled(&scaled(plc, s))?;
+            let mut v = Analysis::run_unscaled(&scaled(plc, s), plc)?;
             v.enclosed = v.enclosed / s / s / s;
             v.planarity_slack = v.planarity_slack / s / s / s;
             return Ok(v);
         }
-        Analysis::run_unscaled(plc)
+        Analysis::run_unscaled(plc, plc)
     }
 
-    fn run_unscaled(plc: &Plc) -> Result<PlcVolume, PlcError> {
-        let (pts, center, canon, diag, (lo, hi)) = check_points(plc)?;
+    /// The analysis of `plc`, which is `raw` or `raw` scaled by a power of
+    /// two; seeds are located exactly in `raw`'s own coordinates.
+    fn run_unscaled(plc: &Plc, raw: &Plc) -> Result<PlcVolume, PlcError> {
+        let (pts, center, canon, diag) = check_points(plc)?;
         let tol = 1e-9 * diag;
         let mut a = Analysis {
             pts,
             center,
-            lo,
-            hi,
             facets: Vec::with_capacity(plc.facets.len()),
             pieces: Vec::new(),
             tol,
@@ -106,7 +102,7 @@ impl Analysis {
         a.check_intersections(&incidences)?;
         let mut sides = UnionFind::new(2 * a.pieces.len());
         a.glue_sides(&incidences, &mut sides)?;
-        a.cells(plc, &mut sides, diag)
+        a.cells(raw, &mut sides, diag)
     }
 
     // ----- points --------------------------------------------------------------
@@ -262,7 +258,7 @@ impl Analysis {
 /// centred on the bounding box of the surface, the centre, the map to
 /// canonical (first coincident) points and the bounding box diagonal.
 #[allow(clippy::type_complexity)] // a private helper's several results
-fn check_points(plc: &Plc) -> Result<(Vec<DVec3>, DVec3, Vec<u32>, f64, (DVec3, DVec3)), PlcError> {
+fn check_points(plc: &Plc) -> Result<(Vec<DVec3>, DVec3, Vec<u32>, f64), PlcError> {
     if let Some((i, p)) = plc
         .points
         .iter()
@@ -347,7 +343,7 @@ fn check_points(plc: &Plc) -> Result<(Vec<DVec3>, DVec3, Vec<u32>, f64, (DVec3, 
         .iter()
         .map(|p| DVec3::from_array(*p) - center)
         .collect();
-    Ok((pts, center, canon, diag, (lo, hi)))
+    Ok((pts, center, canon, diag))
 }
 
 /// Whether some four of the points span a volume, with exact predicates.

@@ -112,7 +112,7 @@ impl Analysis {
                 continue;
             }
             if t <= self.tol {
-                return Ray::OnPiece(k);
+                return Ray::OnPiece;
             }
             hits.push((t, k));
         }
@@ -126,7 +126,7 @@ impl Analysis {
     /// Groups shells into cells, locates the seeds and adds up the volumes.
     pub(super) fn cells(
         &self,
-        plc: &Plc,
+        raw: &Plc,
         sides: &mut UnionFind,
         diag: f64,
     ) -> Result<PlcVolume, PlcError> {
@@ -186,7 +186,7 @@ impl Analysis {
                 let dir = (s * g.n + 0.6 * gdir).normalize();
                 let hits = match self.cast(x0, dir, Some(k)) {
                     Ray::Hits(h) => h,
-                    Ray::Degenerate | Ray::OnPiece(_) => continue,
+                    Ray::Degenerate | Ray::OnPiece => continue,
                 };
                 // Walk along the ray keeping, for every shell crossed, the
                 // change of its winding number; while all are zero the ray is
@@ -257,41 +257,43 @@ impl Analysis {
                 "a cell has volume {v:e} after its cavities are removed"
             )));
         }
+        // Seeds are located exactly, in the input's own coordinates (see
+        // `locate.rs`): the cell of every piece side, and which are bounded.
+        let cell_of_side: Vec<usize> = shell_of_side
+            .iter()
+            .map(|&sh| cells.find(sh as u32) as usize)
+            .collect();
+        let bounded: Vec<bool> = (0..ns)
+            .map(|c| outer_of_cell.contains_key(&(c as u32)))
+            .collect();
         // Hole seeds.
         let mut emptied: Vec<u32> = Vec::new();
         let mut hole_of_cell: HashMap<u32, usize> = HashMap::new();
-        for (i, h) in plc.holes.iter().enumerate() {
-            let x = DVec3::from_array(*h) - self.center;
-            if let Some(c) = self.locate(x, "hole", i, &shell_of_side, &mut cells)? {
-                if outer_of_cell.contains_key(&c) {
-                    emptied.push(c);
-                    hole_of_cell.entry(c).or_insert(i);
-                }
+        for (i, h) in raw.holes.iter().enumerate() {
+            if let Some(c) =
+                self.locate_exact(*h, &raw.points, &cell_of_side, &bounded, "hole", i)?
+            {
+                emptied.push(c as u32);
+                hole_of_cell.entry(c as u32).or_insert(i);
             }
         }
         // Region seeds: each must lie in a bounded cell that no hole empties.
-        // A seed outside the bounding box of the surface is outside (an
-        // exact comparison: no ray is cast from 1e308).
-        for (i, r) in plc.regions.iter().enumerate() {
-            let outside = SeedOutside {
-                index: i + 1,
-                coords: r.point,
-            };
-            let p = DVec3::from_array(r.point);
-            if (0..3).any(|a| p[a] < self.lo[a] || p[a] > self.hi[a]) {
-                return Err(outside);
-            }
-            let x = p - self.center;
-            match self.locate(x, "region", i, &shell_of_side, &mut cells)? {
-                Some(c) if outer_of_cell.contains_key(&c) => {
-                    if let Some(&h) = hole_of_cell.get(&c) {
+        for (i, r) in raw.regions.iter().enumerate() {
+            match self.locate_exact(r.point, &raw.points, &cell_of_side, &bounded, "region", i)? {
+                Some(c) => {
+                    if let Some(&h) = hole_of_cell.get(&(c as u32)) {
                         return Err(PlcError::SeedInHole {
                             index: i + 1,
                             hole: h + 1,
                         });
                     }
                 }
-                _ => return Err(outside),
+                None => {
+                    return Err(SeedOutside {
+                        index: i + 1,
+                        coords: r.point,
+                    })
+                }
             }
         }
         emptied.sort_unstable();
@@ -315,42 +317,5 @@ impl Analysis {
             hole_cells: emptied.len(),
             planarity_slack,
         })
-    }
-
-    /// The cell containing `x` (`None`: the unbounded one).
-    pub(super) fn locate(
-        &self,
-        x: DVec3,
-        what: &'static str,
-        index: usize,
-        shell_of_side: &[usize],
-        cells: &mut UnionFind,
-    ) -> Result<Option<u32>, PlcError> {
-        for dir in ray_directions() {
-            match self.cast(x, dir, None) {
-                Ray::Degenerate => continue,
-                Ray::OnPiece(k) => {
-                    return Err(PlcError::SeedOnFacet {
-                        what,
-                        index: index + 1,
-                        facet: self.pieces[k].facet + 1,
-                    })
-                }
-                Ray::Hits(h) => {
-                    let Some(&(_, k)) = h.first() else {
-                        return Ok(None);
-                    };
-                    let n = self.facets[self.pieces[k].facet].n;
-                    let facing = if n.dot(dir) > 0.0 { -1.0 } else { 1.0 };
-                    return Ok(Some(
-                        cells.find(shell_of_side[side(k, facing) as usize] as u32),
-                    ));
-                }
-            }
-        }
-        Err(PlcError::Inconsistent(format!(
-            "{what} {} cannot be located: every ray from it grazes an edge",
-            index + 1
-        )))
     }
 }

@@ -16,13 +16,22 @@ pub struct Args {
     /// Number of 1:8 steps.
     #[arg(long, default_value_t = 1)]
     pub steps: usize,
+    /// Largest memory the bisection may take (bytes, or with K, M, G, T);
+    /// default: what /proc/meminfo says is available. Every step's peak is
+    /// estimated before any work, and again before the step, and a step
+    /// that would not fit is refused.
+    #[arg(long, value_name = "SIZE")]
+    pub max_memory: Option<String>,
 }
 
 /// Runs `bisect`.
 pub fn run(a: Args) -> super::CliResult {
     tetrefine::io::Format::for_writing(&a.output).map_err(|e| e.to_string())?;
+    let budget = super::guard::MemoryBudget::new(a.max_memory.as_deref())?;
     let mut mesh = super::load(&a.input)?;
+    budget.check_bisect(a.steps, mesh.n_tets() as u64, 1)?;
     for s in 1..=a.steps {
+        budget.check_bisect(1, mesh.n_tets() as u64, s)?;
         let t0 = Instant::now();
         let before = mesh.n_tets();
         mesh = bisect(&mesh).map_err(|e| format!("{}: step {s}: {e}", a.input.display()))?;

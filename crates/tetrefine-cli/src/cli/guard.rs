@@ -15,6 +15,16 @@ pub const STORE_BYTES_PER_TET: u64 = 50;
 /// runs: 384,000 → 2,379,840 → 13,990,012 tets, ratios 6.2 and 5.9).
 pub const TETS_PER_SPLIT_TET: f64 = 6.3;
 
+/// Peak bytes per output tet of a 1:8 bisection run, its input (kept until
+/// the output is built) and the written file included: `VmHWM` 103 MB for
+/// the tripod bisected three times (1,433,088 output tets, 72 bytes each),
+/// rounded up.
+pub const BISECT_BYTES_PER_OUTPUT_TET: u64 = 100;
+/// Peak bytes per tet of `improve` (reading, the store, its queues and the
+/// statistics before and after): `VmHWM` 192 MB for the 1,433,088 tets of
+/// the tripod bisected three times (134 bytes each), rounded up.
+pub const IMPROVE_BYTES_PER_TET: u64 = 200;
+
 /// Parses `--max-memory`: bytes, or with a suffix K, M, G, T (powers of 1024).
 pub fn parse_bytes(s: &str) -> Result<u64, String> {
     let t = s.trim();
@@ -84,6 +94,50 @@ impl MemoryBudget {
                 source: "MemAvailable in /proc/meminfo plus this process's resident memory",
             },
         })
+    }
+
+    /// Refuses `what` (e.g. "step 3 of bisect") when `need` bytes (`how`:
+    /// how they were estimated) exceed the budget.
+    pub fn check(&self, what: &str, need: f64, how: &str) -> Result<(), String> {
+        let Some(limit) = self.limit else {
+            return Ok(());
+        };
+        if need > limit as f64 {
+            return Err(format!(
+                "{what} would not fit in memory: {how} need about {} at the peak, but {} allows {}; ask for less, or set --max-memory",
+                human(need),
+                self.source,
+                human(limit as f64)
+            ));
+        }
+        Ok(())
+    }
+
+    /// Refuses `steps` bisection steps of a mesh of `tets` tets at the first
+    /// step whose peak would not fit (each step has 8 times the tets).
+    pub fn check_bisect(&self, steps: usize, tets: u64, first_step: usize) -> Result<(), String> {
+        let mut n = tets as f64;
+        for s in first_step..first_step + steps {
+            let out = (8.0 * n).min(1e30);
+            self.check(
+                &format!("bisect step {s}"),
+                out * BISECT_BYTES_PER_OUTPUT_TET as f64,
+                &format!(
+                    "{n:.3e} → {out:.3e} tets at {BISECT_BYTES_PER_OUTPUT_TET} bytes per output tet (measured)"
+                ),
+            )?;
+            n = out;
+        }
+        Ok(())
+    }
+
+    /// Refuses `improve` of a mesh of `tets` tets whose peak would not fit.
+    pub fn check_improve(&self, tets: u64) -> Result<(), String> {
+        self.check(
+            "improve",
+            (tets * IMPROVE_BYTES_PER_TET) as f64,
+            &format!("{tets} tets at {IMPROVE_BYTES_PER_TET} bytes per tet (measured)"),
+        )
     }
 
     /// Refuses step `step` when its estimated peak exceeds the budget: a

@@ -16,12 +16,19 @@ pub struct Args {
     /// Maximum passes of edge removal + smoothing.
     #[arg(long, default_value_t = 5)]
     pub opt_passes: usize,
+    /// Largest memory `improve` may take (bytes, or with K, M, G, T);
+    /// default: what /proc/meminfo says is available. The peak is estimated
+    /// from the tet count and a mesh that would not fit is refused.
+    #[arg(long, value_name = "SIZE")]
+    pub max_memory: Option<String>,
 }
 
 /// Runs `improve`.
 pub fn run(a: Args) -> super::CliResult {
     tetrefine::io::Format::for_writing(&a.output).map_err(|e| e.to_string())?;
+    let budget = super::guard::MemoryBudget::new(a.max_memory.as_deref())?;
     let mut mesh = super::load(&a.input)?;
+    budget.check_improve(mesh.n_tets() as u64)?;
     let before = MeshStats::compute(&mesh);
     let report = improve(
         &mut mesh,

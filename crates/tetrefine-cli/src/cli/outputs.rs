@@ -14,6 +14,7 @@ static STDOUT_ERROR: Mutex<Option<String>> = Mutex::new(None);
 /// Writes one line to standard output; a failure is remembered and fails
 /// the command at its end ([`finish_stdout`]).
 pub fn say_line(args: std::fmt::Arguments<'_>) {
+    refuse_closed_stdout();
     let mut out = std::io::stdout().lock();
     if let Err(e) = out.write_fmt(args).and_then(|()| out.write_all(b"\n")) {
         record(e);
@@ -22,8 +23,44 @@ pub fn say_line(args: std::fmt::Arguments<'_>) {
 
 /// Writes text to standard output as it is (see [`say_line`]).
 pub fn say_text(text: &str) {
+    refuse_closed_stdout();
     if let Err(e) = std::io::stdout().lock().write_all(text.as_bytes()) {
         record(e);
+    }
+}
+
+/// Records an error when standard output was closed when the process
+/// started (`>&-`). Rust's runtime then opens `/dev/null` read-write on
+/// descriptor 1 before `main`, so every write "succeeds" and the output is
+/// lost without a word; a shell's `> /dev/null` opens it write-only, so
+/// `/dev/null` read-write on descriptor 1 is taken for a closed one (only
+/// `1<>/dev/null` looks the same, and discards the output just as well).
+fn refuse_closed_stdout() {
+    static CLOSED: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
+    let closed = *CLOSED.get_or_init(|| {
+        // SAFETY: fcntl and fstat/stat on a descriptor and a fixed path,
+        // with zeroed out-structures of the right type.
+        unsafe {
+            let flags = libc::fcntl(1, libc::F_GETFL);
+            if flags < 0 {
+                return true;
+            }
+            if flags & libc::O_ACCMODE != libc::O_RDWR {
+                return false;
+            }
+            let (mut fd, mut null): (libc::stat, libc::stat) =
+                (std::mem::zeroed(), std::mem::zeroed());
+            libc::fstat(1, &mut fd) == 0
+                && libc::stat(c"/dev/null".as_ptr(), &mut null) == 0
+                && (fd.st_mode & libc::S_IFMT) == libc::S_IFCHR
+                && fd.st_rdev == null.st_rdev
+        }
+    });
+    if closed {
+        record(std::io::Error::new(
+            std::io::ErrorKind::BrokenPipe,
+            "it was closed when the command started",
+        ));
     }
 }
 

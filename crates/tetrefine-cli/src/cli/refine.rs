@@ -8,7 +8,7 @@ use std::time::Instant;
 use tetrefine::io::read_indicator;
 use tetrefine::report::{step_row, step_table_header};
 use tetrefine::MeshStats;
-use tetrefine::{locate_parents, refine_with, Phase, RefineOptions, Sqrt3Rule};
+use tetrefine::{locate_parents, Phase, RefineOptions, Sqrt3Rule};
 use tetrefine::{select, MarkStrategy};
 
 /// The `--stats` file: `{"steps": [input, step 1, …]}`.
@@ -239,9 +239,22 @@ pub fn run(a: Args) -> super::CliResult {
         None => Phase::ALL.len(),
     };
     let progress = BarProgress::new(a.steps, phases_per_step);
-    refine_with(&mut mesh, a.steps, &opts, &progress, |s, mesh, report| {
-        let stats = MeshStats::compute(mesh);
-        progress.suspend(|| {
+    // The plan above projected every step; before each step its real tet
+    // counts are held against the budget again (a step of a mesh that grew
+    // more than projected is refused, naming it, with nothing written).
+    let kept = input.n_tets() as u64;
+    let before_step = |s: usize, mesh: &tetrefine::TetMesh, split: u64| {
+        budget.check_step(s, mesh.n_tets() as u64, split, kept)
+    };
+    tetrefine::refine_with_guard(
+        &mut mesh,
+        a.steps,
+        &opts,
+        &progress,
+        before_step,
+        |s, mesh, report| {
+            let stats = MeshStats::compute(mesh);
+            progress.suspend(|| {
             crate::say!("{}", step_row(&format!("step {s}"), &stats, report.seconds));
             if report.refused_flips + report.refused_boundary_flips + report.skipped_moves > 0 {
                 eprintln!(
@@ -250,8 +263,9 @@ pub fn run(a: Args) -> super::CliResult {
                 );
             }
         });
-        steps.push(StepStats::step(stats, &report));
-    });
+            steps.push(StepStats::step(stats, &report));
+        },
+    )?;
     progress.finish();
     locate_parents(&input, &mut mesh);
     if let Some(path) = &a.stats {

@@ -336,6 +336,27 @@ fn a_failed_write_to_standard_output_fails_the_command() {
     assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
     assert!(stderr(&o).contains("standard output"), "{}", stderr(&o));
     assert!(!out.exists(), "no output after a failed command");
+    // `>&-`: standard output closed when the command starts.
+    let o = Command::new("sh")
+        .arg("-c")
+        .arg(format!(
+            "'{}' quality '{}' --json -o '{}' >&-",
+            env!("CARGO_BIN_EXE_tetrefine"),
+            tripod.display(),
+            out.display()
+        ))
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(stderr(&o).contains("standard output"), "{}", stderr(&o));
+    assert!(!out.exists(), "no output after a failed command");
+    // `> /dev/null` is a place to write to, not an error.
+    let o = Command::new(env!("CARGO_BIN_EXE_tetrefine"))
+        .args(["quality", tripod.to_str().unwrap(), "--json"])
+        .stdout(std::process::Stdio::null())
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
 }
 
 #[test]
@@ -420,12 +441,17 @@ fn degenerate_and_empty_selections_and_steps_zero_are_errors() {
     let o_ = out.to_str().unwrap();
     let tripod = meshes().join("tripod.mesh");
     let t = tripod.to_str().unwrap();
-    let cases: [(&[&str], &str); 5] = [
+    let cases: [(&[&str], &str); 10] = [
         (&["--steps", "0"], "--steps 0"),
         (&["--box", "0,0,0,0,1,1"], "zero extent along x"),
+        (&["--box", "1,1,1,0,0,0"], "inverted along x"),
+        (&["--mark", "box:-50,50,-50,50,-50,50"], "inverted along y"),
+        (&["--sphere", "0,0,0,0"], "radius"),
+        (&["--mark", "region:0,99"], "no region 99"),
         (&["--sphere", "0,0,0,-1"], "radius"),
         (&["--region", "99"], "no region 99"),
         (&["--sphere", "1e6,1e6,1e6,1"], "selects none"),
+        (&["--box", "1e6,1e6,1e6,2e6,2e6,2e6"], "selects none"),
     ];
     for (extra, word) in cases {
         let mut args = vec!["refine", t, "-o", o_];
@@ -858,4 +884,135 @@ fn fuzz_findings_in_tests_bad_surface_give_one_line_naming_the_file() {
         "{e}"
     );
     assert!(!out.exists());
+}
+
+/// Issue 21: the memory guard also holds each refine step's real counts
+/// against the budget (the tripod grows faster than the ×6.3 projection,
+/// so a budget between the two lets the plan pass and refuses step 2 by
+/// name), and it guards `bisect` and `improve`.
+#[test]
+fn the_memory_guard_checks_each_step_and_bisect_and_improve() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("o.mesh");
+    let (t, o_) = (
+        meshes().join("tripod.mesh"),
+        out.to_str().unwrap().to_string(),
+    );
+    let t = t.to_str().unwrap();
+    // Projected: step 2 needs 11.3 MB; really 23,345 tets enter it: 14.9 MB.
+    let o = tetrefine(&[
+        "refine",
+        t,
+        "-o",
+        &o_,
+        "--steps",
+        "2",
+        "--max-memory",
+        "13M",
+    ]);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("step 2 would not fit") && stderr(&o).contains("--max-memory"),
+        "{}",
+        stderr(&o)
+    );
+    assert!(!out.exists());
+    let o = tetrefine(&[
+        "refine",
+        t,
+        "-o",
+        &o_,
+        "--steps",
+        "2",
+        "--max-memory",
+        "20M",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    std::fs::remove_file(&out).unwrap();
+    // bisect: refused before any work, naming the step.
+    let t0 = std::time::Instant::now();
+    let o = tetrefine(&["bisect", t, "-o", &o_, "--steps", "30"]);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("bisect step") && stderr(&o).contains("would not fit"),
+        "{}",
+        stderr(&o)
+    );
+    assert!(t0.elapsed().as_secs() < 20 && !out.exists());
+    // 22,392 output tets of step 1 at 100 bytes: more than 1 MiB.
+    let o = tetrefine(&["bisect", t, "-o", &o_, "--max-memory", "1M"]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(
+        stderr(&o).contains("bisect step 1 would not fit"),
+        "{}",
+        stderr(&o)
+    );
+    assert!(o.stdout.is_empty() && !out.exists());
+    let o = tetrefine(&["bisect", t, "-o", &o_, "--max-memory", "8M"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    std::fs::remove_file(&out).unwrap();
+    // improve: 2,799 tets at 200 bytes is more than 100 KiB.
+    let o = tetrefine(&["improve", t, "-o", &o_, "--max-memory", "100K"]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(
+        stderr(&o).contains("improve would not fit"),
+        "{}",
+        stderr(&o)
+    );
+    assert!(!out.exists());
+    let o = tetrefine(&["improve", t, "-o", &o_, "--max-memory", "0"]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(stderr(&o).contains("--max-memory"), "{}", stderr(&o));
+    let o = tetrefine(&[
+        "improve",
+        t,
+        "-o",
+        &o_,
+        "--max-memory",
+        "1G",
+        "--opt-passes",
+        "1",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+}
+
+/// Issue 21: `surface` steps are guarded by memory as `refine` is: a run
+/// whose projected output would not fit `--max-memory` is refused before
+/// any work, with no output.
+#[test]
+fn surface_steps_are_held_against_the_memory_budget() {
+    let dir = tempfile::tempdir().unwrap();
+    let tet = dir.path().join("tet.obj");
+    std::fs::write(
+        &tet,
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 2 3 4\nf 1 4 3\n",
+    )
+    .unwrap();
+    let out = dir.path().join("o.obj");
+    let run = |steps: &str, mem: &str| {
+        tetrefine(&[
+            "surface",
+            "loop",
+            tet.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+            "--steps",
+            steps,
+            "--max-memory",
+            mem,
+        ])
+    };
+    // 12 sides × 4⁵ = 12,288 projected faces at 300 bytes: 3.7 MB.
+    let o = run("6", "1M");
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("6 steps would not fit in memory")
+            && stderr(&o).contains("--max-memory"),
+        "{}",
+        stderr(&o)
+    );
+    assert!(!out.exists());
+    let o = run("3", "1M");
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(out.exists());
 }
