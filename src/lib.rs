@@ -58,8 +58,8 @@ pub use mesh::{BuildReport, CheckError, MeshData, MeshError, Remap, TetMesh, Whe
 pub use ops::OpError;
 pub use refine::marking::{select, MarkStrategy};
 pub use refine::{
-    locate_parents, refine, refine_step, refine_with, NoProgress, Phase, PhaseReport, Progress,
-    RefineOptions, StepReport,
+    copy_cell_field, interpolate_point_field, locate_parents, locate_points, refine, refine_step,
+    refine_with, NoProgress, Phase, PhaseReport, PointParent, Progress, RefineOptions, StepReport,
 };
 pub use report::{format_table, write_histogram, MeshStats};
 pub use stencil::Sqrt3Rule;

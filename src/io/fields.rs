@@ -93,3 +93,65 @@ pub fn write_point_fields(path: &Path, meta: &MeshMeta, n_points: usize) -> Resu
     };
     write_sol(path, &sol, 2)
 }
+
+/// The solution files [`write_fields_beside`] writes for the mesh file
+/// `mesh_path`, as MMG names them: `OUT.mesh` → `OUT.sol` (point fields,
+/// `SolAtVertices`) and `OUT.tets.sol` (cell fields, `SolAtTetrahedra`);
+/// `OUT.meshb` → `OUT.solb` and `OUT.tets.solb`. `None` for other formats.
+pub fn fields_beside(mesh_path: &Path) -> Option<(std::path::PathBuf, std::path::PathBuf)> {
+    let ext = mesh_path.extension()?.to_str()?.to_ascii_lowercase();
+    let sol = match ext.as_str() {
+        "mesh" => "sol",
+        "meshb" => "solb",
+        _ => return None,
+    };
+    Some((
+        mesh_path.with_extension(sol),
+        mesh_path.with_extension(format!("tets.{sol}")),
+    ))
+}
+
+/// Writes the fields of `meta` beside a Medit mesh file (see
+/// [`fields_beside`]): the point fields with `n_points` entries and the cell
+/// fields with `n_tets` entries whose component count is a libMeshb type
+/// (1, 3, 6 or 9). Returns the files written and the names of the fields
+/// left out (other component counts).
+pub fn write_fields_beside(
+    mesh_path: &Path,
+    meta: &MeshMeta,
+    n_points: usize,
+    n_tets: usize,
+) -> Result<(Vec<std::path::PathBuf>, Vec<String>), IoError> {
+    let Some((points_path, cells_path)) = fields_beside(mesh_path) else {
+        return Ok((Vec::new(), Vec::new()));
+    };
+    let mut written = Vec::new();
+    let mut skipped = Vec::new();
+    for (path, fields, at, n) in [
+        (points_path, &meta.point_fields, SolAt::Vertices, n_points),
+        (cells_path, &meta.cell_fields, SolAt::Tetrahedra, n_tets),
+    ] {
+        let mut solutions = Vec::new();
+        for f in fields.iter().filter(|f| f.values.len() == n * f.components) {
+            match kind_of(f.components) {
+                Some(kind) => solutions.push(Solution {
+                    kind,
+                    field: f.clone(),
+                }),
+                None => skipped.push(f.name.clone()),
+            }
+        }
+        if solutions.is_empty() {
+            continue;
+        }
+        let sol = SolFile {
+            at,
+            entries: n,
+            solutions,
+            line: None,
+        };
+        write_sol(&path, &sol, 2)?;
+        written.push(path);
+    }
+    Ok((written, skipped))
+}

@@ -224,9 +224,16 @@ pub fn read_mesh_with_meta_noted(
 fn read_mesh_file_with_meta(
     path: &Path,
 ) -> Result<(MeshData, meta::MeshMeta, Vec<String>), IoError> {
-    if Format::for_reading(path)? == Format::Gmsh {
-        let (d, m) = gmsh::read_with_meta(path)?;
-        return Ok((d, m, Vec::new()));
+    match Format::for_reading(path)? {
+        Format::Gmsh => {
+            let (d, m) = gmsh::read_with_meta(path)?;
+            return Ok((d, m, Vec::new()));
+        }
+        Format::Vtu => {
+            let (d, m, n) = vtk::read_with_meta_noted(path)?;
+            return Ok((d, m, n.into_iter().collect()));
+        }
+        _ => {}
     }
     let (d, notes) = read_mesh_file(path)?;
     Ok((d, meta::MeshMeta::default(), notes))

@@ -22,9 +22,11 @@ pub mod features;
 pub mod marking;
 pub mod parents;
 pub mod step;
+pub mod transfer;
 
 pub use parents::locate_parents;
 pub use step::{refine, refine_step, refine_step_with_progress, refine_with};
+pub use transfer::{copy_cell_field, interpolate_point_field, locate_points, PointParent};
 
 /// Progress callbacks for long phases (the CLI draws bars with them).
 /// Every method has a no-op default.

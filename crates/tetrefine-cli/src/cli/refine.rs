@@ -83,10 +83,29 @@ pub struct Args {
     /// out bit-identical; `all` optimises everywhere.
     #[arg(long, default_value = "refined")]
     pub smooth: SmoothScope,
-    /// Write `new_tet parent_tet` per line (0-based output and input ids), so
-    /// a solver can carry its fields over.
+    /// Write `new_tet parent_tet` per line (0-based output and input ids),
+    /// then, after a `# points` line, the vertex parent map: per output
+    /// point `new_point input_tet v0 v1 v2 v3 b0 b1 b2 b3 outside` (the
+    /// input tet holding it, its vertices and the point's barycentric
+    /// coordinates), so a solver can carry its fields over.
     #[arg(long)]
     pub parent_map: Option<PathBuf>,
+    /// Carry the input's fields over (the default when it has any: `.vtu`
+    /// point and cell data, Gmsh `$NodeData`, `--fields`): point fields
+    /// interpolated linearly in the input tet holding each output point,
+    /// cell fields copied from each tet's parent.
+    #[arg(long, overrides_with = "no_transfer")]
+    pub transfer: bool,
+    /// Drop the input's fields instead of carrying them over.
+    #[arg(long, overrides_with = "transfer")]
+    pub no_transfer: bool,
+    /// Point or cell fields of the input from a Medit solution (.sol or
+    /// .solb: SolAtVertices → point fields, SolAtTetrahedra → cell fields);
+    /// repeatable. Written as `.vtu` point/cell data, Gmsh
+    /// `$NodeData`/`$ElementData`, or `OUT.sol` (points) and `OUT.tets.sol`
+    /// (tets) beside a `.mesh` output.
+    #[arg(long)]
+    pub fields: Vec<PathBuf>,
     /// Refinement rounds already done on this mesh (in an adaptive loop,
     /// the round number): feature edges are kept in odd and trisected in
     /// even global steps.
@@ -183,7 +202,42 @@ pub fn run(a: Args) -> super::CliResult {
         tetrefine::polyline::PolylineFormat::of(f).map_err(|e| e.to_string())?;
     }
     let strategy = mark_strategy(&a)?;
-    let (mut input, meta) = super::load_with_meta(&a.input)?;
+    let (mut input, mut meta) = super::load_with_meta(&a.input)?;
+    for f in &a.fields {
+        tetrefine::io::fields::add_sol_fields(f, &mut meta, input.n_points(), input.n_tets())
+            .map_err(|e| e.to_string())?;
+    }
+    let has_fields = !meta.point_fields.is_empty() || !meta.cell_fields.is_empty();
+    if a.transfer && !a.no_transfer && !has_fields {
+        return Err(format!(
+            "--transfer: {} carries no point or cell field (give one with --fields FILE.sol)",
+            a.input.display()
+        ));
+    }
+    let transfer = has_fields && !a.no_transfer;
+    if transfer {
+        let beside = tetrefine::io::fields::fields_beside(&a.output);
+        super::outputs::refuse_shared_paths(&[
+            ("-o", Some(a.output.as_path())),
+            ("--stats", a.stats.as_deref()),
+            ("--histogram", a.histogram.as_deref()),
+            ("--features-out", a.features_out.as_deref()),
+            ("--parent-map", a.parent_map.as_deref()),
+            (
+                "the point fields beside -o",
+                beside.as_ref().map(|b| b.0.as_path()),
+            ),
+            (
+                "the cell fields beside -o",
+                beside.as_ref().map(|b| b.1.as_path()),
+            ),
+        ])?;
+        eprintln!(
+            "transfer: {} point and {} cell fields of the input",
+            meta.point_fields.len(),
+            meta.cell_fields.len()
+        );
+    }
     let selection = match &strategy {
         Some(st) => {
             let values = match &a.indicator {
@@ -261,20 +315,12 @@ pub fn run(a: Args) -> super::CliResult {
             .map_err(|e| e.to_string())?;
     }
     mesh.compact();
-    if let Some(path) = &a.parent_map {
-        let ids: Vec<u32> = mesh.tet_ids().collect();
-        tetrefine::io::write_atomic(path, |w| {
-            use std::io::Write;
-            writeln!(
-                w,
-                "# new_tet parent_tet (0-based; parent = input tet holding the centroid)"
-            )?;
-            for (i, &t) in ids.iter().enumerate() {
-                writeln!(w, "{i} {}", mesh.parent(t))?;
-            }
-            Ok(())
-        })
-        .map_err(|e| e.to_string())?;
+    let is_vtu = tetrefine::io::Format::for_writing(&a.output).map_err(|e| e.to_string())?
+        == tetrefine::io::Format::Vtu;
+    let locations = (transfer || is_vtu || a.parent_map.is_some())
+        .then(|| tetrefine::locate_points(&input, &mesh));
+    if let (Some(path), Some(locs)) = (&a.parent_map, &locations) {
+        super::transfer::write_parent_map(path, &input, &mesh, locs)?;
     }
     // Whether the tet descends from a selected input tet (all do without a
     // selection).
@@ -287,16 +333,25 @@ pub fn run(a: Args) -> super::CliResult {
         msh_format: a.msh_format,
     };
     // Names and tag lists stay valid through refinement (every child keeps its
-    // parent's region and markers); the input's fields do not.
-    let mut meta = meta;
-    meta.point_fields.clear();
-    meta.cell_fields.clear();
+    // parent's region and markers); the fields are carried over or dropped.
+    let (point_fields, cell_fields) = match (&locations, transfer) {
+        (Some(locs), true) => super::transfer::transfer_fields(&input, &mesh, &meta, locs),
+        _ => (Vec::new(), Vec::new()),
+    };
+    let arrays = if is_vtu {
+        super::transfer::vtu_arrays(&input, locations.as_deref(), &point_fields, &cell_fields)
+    } else {
+        (Vec::new(), Vec::new())
+    };
+    meta.point_fields = point_fields;
+    meta.cell_fields = cell_fields;
     super::write_refined(
         &a.output,
         &mut mesh,
         &[("marked", &marked)],
         &meta,
         &options,
+        arrays,
     )?;
     if let Some(f) = &a.features_out {
         super::write_feature_lines(f, &mesh)?;

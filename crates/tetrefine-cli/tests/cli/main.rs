@@ -18,6 +18,7 @@ mod readme_commands;
 mod refine;
 mod strict;
 mod surface;
+mod transfer;
 
 use std::process::Command;
 
