@@ -55,7 +55,7 @@ pub use file::IoError;
 pub use improve::{improve, ImproveOptions, ImproveReport};
 pub use io::{load_mesh, read_mesh, write_mesh};
 pub use mesh::{BuildReport, CheckError, MeshData, MeshError, Remap, TetMesh, Where};
-pub use ops::OpError;
+pub use ops::{split_edge, OpError};
 pub use refine::marking::{select, MarkStrategy};
 pub use refine::{
     copy_cell_field, interpolate_point_field, locate_parents, locate_points, refine, refine_step,
