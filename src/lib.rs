@@ -57,6 +57,9 @@ pub use io::{load_mesh, read_mesh, write_mesh};
 pub use mesh::{BuildReport, CheckError, MeshData, MeshError, Remap, TetMesh, Where};
 pub use ops::{split_edge, OpError};
 pub use refine::marking::{select, MarkStrategy};
+pub use refine::size::{
+    is_positive_definite, size_pass, worst_quality, SizeMap, SizeOptions, SizeReport, SPLIT_ABOVE,
+};
 pub use refine::{
     copy_cell_field, interpolate_point_field, locate_parents, locate_points, refine, refine_step,
     refine_with, NoProgress, Phase, PhaseReport, PointParent, Progress, RefineOptions, StepReport,

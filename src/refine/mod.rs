@@ -26,7 +26,6 @@ pub mod step;
 pub mod transfer;
 
 pub use parents::locate_parents;
-pub use size::{size_pass, SizeMap, SizeOptions, SizeReport};
 pub use step::{refine, refine_step, refine_step_with_progress, refine_with};
 pub use transfer::{copy_cell_field, interpolate_point_field, locate_points, PointParent};
 

@@ -12,8 +12,10 @@
 //! ([`crate::ops::split_edge`]), longest first, the new point's metric the
 //! mean of the two ends' (a mean of positive-definite matrices is positive
 //! definite); a split that would create a tet worse than the quality floor
-//! (by default the input's worst) is refused, so quality never drops below
-//! it. The optimize phase ([`crate::improve::improve`]) runs after each pass.
+//! (by default the worst tet when the pass begins; for a metric, quality is
+//! measured after mapping the tet by the metric's Cholesky factor, since an
+//! anisotropic mesh is meant to be well shaped in the metric, not in x, y,
+//! z) is refused, so quality never drops below it. The optimize phase ([`crate::improve::improve`]) runs after each pass.
 //! The √3 operations never remove an old interior edge, which is why the
 //! size loop needs these splits.
 //!
@@ -97,6 +99,35 @@ impl SizeMap {
         0.5 * (self.length_at(a, e) + self.length_at(b, e))
     }
 
+    /// The map `x → Lᵀx` with `LLᵀ` the mean metric of the points `vs`
+    /// (Cholesky), under which Euclidean lengths are metric lengths; `None`
+    /// for an isotropic map, whose quality is the Euclidean one (the
+    /// minimum sine is invariant under scaling). The Cholesky factor of a
+    /// positive-definite matrix has a positive diagonal, so the map keeps
+    /// orientation.
+    pub fn transform(&self, vs: &[u32]) -> Option<DMat3> {
+        let SizeMap::Aniso(m) = self else {
+            return None;
+        };
+        let k = vs.len().max(1) as f64;
+        let mean: [f64; 6] =
+            std::array::from_fn(|i| vs.iter().map(|&v| m[v as usize][i]).sum::<f64>() / k);
+        let a = matrix(&mean);
+        let l11 = a.col(0)[0].max(0.0).sqrt();
+        let l21 = a.col(0)[1] / l11;
+        let l31 = a.col(0)[2] / l11;
+        let l22 = (a.col(1)[1] - l21 * l21).max(0.0).sqrt();
+        let l32 = (a.col(1)[2] - l31 * l21) / l22;
+        let l33 = (a.col(2)[2] - l31 * l31 - l32 * l32).max(0.0).sqrt();
+        // Lᵀ, column by column (glam matrices are column-major).
+        let lt = DMat3::from_cols(
+            DVec3::new(l11, 0.0, 0.0),
+            DVec3::new(l21, l22, 0.0),
+            DVec3::new(l31, l32, l33),
+        );
+        lt.is_finite().then_some(lt)
+    }
+
     /// Appends the size of a new point halfway between `a` and `b`.
     fn push_mean(&mut self, a: u32, b: u32) {
         match self {
@@ -157,22 +188,14 @@ pub struct SizeReport {
 }
 
 /// Options of [`size_pass`].
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, Default)]
 pub struct SizeOptions {
     /// Minimum sine of the signed dihedral angles no new tet may fall
-    /// below (`None`: the worst tet of the mesh when the pass begins).
+    /// below, measured in the metric for an anisotropic map (`None`: the
+    /// worst tet of the mesh when the pass begins, [`worst_metric_quality`]).
     pub quality_floor: Option<f64>,
     /// The optimize phase after the splits (`passes: 0` skips it).
     pub improve: ImproveOptions,
-}
-
-impl Default for SizeOptions {
-    fn default() -> Self {
-        SizeOptions {
-            quality_floor: None,
-            improve: ImproveOptions::default(),
-        }
-    }
 }
 
 /// The long edges of `mesh`, longest first (ties by vertex ids).
@@ -202,11 +225,30 @@ pub fn worst_quality(mesh: &TetMesh) -> f64 {
         .fold(f64::INFINITY, f64::min)
 }
 
+/// The minimum sine of the tet with corners `p` seen through `t`.
+fn quality_in(t: Option<DMat3>, p: [DVec3; 4]) -> f64 {
+    match t {
+        Some(t) => tet_min_sine(&p.map(|x| t * x)),
+        None => tet_min_sine(&p),
+    }
+}
+
+/// The worst minimum sine over the live tets in the metric of `size`
+/// (each tet through the mean metric of its corners; the Euclidean
+/// [`worst_quality`] for an isotropic map).
+pub fn worst_metric_quality(mesh: &TetMesh, size: &SizeMap) -> f64 {
+    mesh.tet_ids()
+        .map(|t| quality_in(size.transform(&mesh.tet(t)), mesh.tet_points(t)))
+        .fold(f64::INFINITY, f64::min)
+}
+
 /// One size pass (see the module documentation). `size` covers the points
 /// of `mesh` and grows with it.
 pub fn size_pass(mesh: &mut TetMesh, size: &mut SizeMap, opts: &SizeOptions) -> SizeReport {
     assert_eq!(size.len(), mesh.n_points(), "one size per point");
-    let floor = opts.quality_floor.unwrap_or_else(|| worst_quality(mesh));
+    let floor = opts
+        .quality_floor
+        .unwrap_or_else(|| worst_metric_quality(mesh, size));
     let long = long_edges(mesh, size);
     let mut report = SizeReport {
         long_edges: long.len(),
@@ -222,7 +264,9 @@ pub fn size_pass(mesh: &mut TetMesh, size: &mut SizeMap, opts: &SizeOptions) -> 
         }
         let (pa, pb) = (mesh.point(a), mesh.point(b));
         let mid = (pa + pb) * 0.5;
-        // The pieces' quality, before splitting: refuse below the floor.
+        // The pieces' quality (in the metric of the edge), before
+        // splitting: refuse below the floor.
+        let tr = size.transform(&[a, b]);
         let worst_new = shell
             .iter()
             .flat_map(|&t| {
@@ -238,7 +282,7 @@ pub fn size_pass(mesh: &mut TetMesh, size: &mut SizeMap, opts: &SizeOptions) -> 
                         p2[i] = mid;
                     }
                 }
-                [tet_min_sine(&p1), tet_min_sine(&p2)]
+                [quality_in(tr, p1), quality_in(tr, p2)]
             })
             .fold(f64::INFINITY, f64::min);
         if worst_new < floor {

@@ -10,6 +10,7 @@ pub mod outputs;
 pub mod progress;
 pub mod quality;
 pub mod refine;
+pub mod size;
 pub mod steps;
 pub mod surface;
 pub mod transfer;

@@ -25,9 +25,28 @@ pub struct Args {
     /// Output mesh (.vtu, .mesh, .msh, .node).
     #[arg(short, long)]
     pub output: PathBuf,
-    /// Number of √3 steps.
-    #[arg(long, default_value_t = 1)]
-    pub steps: usize,
+    /// Number of √3 steps (default 1); with a size map, of size passes, or
+    /// `auto`: passes until no edge is longer than its target (at most 20;
+    /// the default with a size map).
+    #[arg(long)]
+    pub steps: Option<super::size::Steps>,
+    /// MMG size map: a Medit `.sol` with SolAtVertices of type 1 (a target
+    /// edge length per point) or type 3 (a metric per point, MMG's order
+    /// m11 m12 m22 m13 m23 m33). Refines by splitting every edge longer
+    /// than its target instead of √3 steps.
+    #[arg(long)]
+    pub size: Option<PathBuf>,
+    /// The size map is this point array of the input (`.vtu` point data or
+    /// Gmsh `$NodeData`; 1 component: a length, 6: a metric).
+    #[arg(long)]
+    pub size_array: Option<String>,
+    /// A uniform target edge length (MMG's -hsiz).
+    #[arg(long)]
+    pub hsiz: Option<f64>,
+    /// The largest target edge length (MMG's -hmax): caps the size map, or
+    /// alone is a uniform target.
+    #[arg(long)]
+    pub hmax: Option<f64>,
     /// Boundary rule: interpolating (Labsik–Greiner), approximating (Kobbelt) or linear.
     #[arg(long, default_value = "interpolating")]
     pub boundary: Sqrt3Rule,
@@ -179,7 +198,44 @@ pub fn run(a: Args) -> super::CliResult {
         ("--features-out", a.features_out.as_deref()),
         ("--parent-map", a.parent_map.as_deref()),
     ])?;
-    if a.steps == 0 && !a.allow_steps_zero {
+    let size_given =
+        a.size.is_some() || a.size_array.is_some() || a.hsiz.is_some() || a.hmax.is_some();
+    let n_steps = match (a.steps, size_given) {
+        (Some(super::size::Steps::N(n)), _) => n,
+        (None, false) => 1,
+        (None, true) | (Some(super::size::Steps::Auto), true) => super::size::AUTO_CAP,
+        (Some(super::size::Steps::Auto), false) => {
+            return Err("--steps auto refines until every edge meets a size map: give --size FILE.sol, --size-array NAME, --hsiz H or --hmax H".into())
+        }
+    };
+    let auto = size_given && a.steps.is_none_or(|s| s == super::size::Steps::Auto);
+    if size_given {
+        if let Some(p) = &a.size {
+            super::outputs::refuse_shared_paths(&[
+                ("-o", Some(a.output.as_path())),
+                ("--size", Some(p.as_path())),
+            ])?;
+        }
+        if a.indicator.is_some()
+            || !a.marks.is_empty()
+            || a.region.is_some()
+            || a.select_box.is_some()
+            || a.sphere.is_some()
+        {
+            return Err("a size map chooses what to refine itself: drop --indicator/--mark/--region/--box/--sphere, or the size options".into());
+        }
+        if a.stop_after.is_some() {
+            return Err(
+                "--stop-after names a phase of the √3 step; size-driven refinement has none".into(),
+            );
+        }
+    }
+    if let Some(spec) = &a.indicator {
+        if spec.to_ascii_lowercase().ends_with(".sol") {
+            eprintln!("note: --indicator {spec}: read as an error indicator (larger = refine; SolAtVertices: a tet takes the maximum of its vertices); an MMG size map (target edge lengths) is --size FILE.sol");
+        }
+    }
+    if n_steps == 0 && !a.allow_steps_zero {
         return Err("--steps 0 refines nothing; give --steps N ≥ 1 (or --allow-steps-zero to write the mesh unrefined)".into());
     }
     let budget = super::guard::MemoryBudget::new(a.max_memory.as_deref())?;
@@ -263,12 +319,20 @@ pub fn run(a: Args) -> super::CliResult {
         .as_ref()
         .map_or(input.n_tets(), |s| s.iter().filter(|&&x| x).count()) as u64;
     budget.check_plan(
-        a.steps,
+        if size_given { 1 } else { n_steps },
         input.n_tets() as u64,
         selected,
         input.n_tets() as u64,
     )?;
     super::apply_feature_option(&mut input, &a.features, a.feature_angle)?;
+    let size = super::size::size_map(
+        a.size.as_deref(),
+        a.size_array.as_deref(),
+        a.hsiz,
+        a.hmax,
+        &input,
+        &meta,
+    )?;
     let mut mesh = input.clone();
     let opts = RefineOptions {
         boundary: a.boundary,
@@ -292,10 +356,61 @@ pub fn run(a: Args) -> super::CliResult {
             .map_or(Phase::ALL.len(), |i| i + 1),
         None => Phase::ALL.len(),
     };
-    let progress = BarProgress::new(a.steps, phases_per_step);
-    refine_with(&mut mesh, a.steps, &opts, &progress, |s, mesh, report| {
-        let stats = MeshStats::compute(mesh);
-        progress.suspend(|| {
+    if let Some(mut size) = size {
+        // The floor: each pass's worst tet at its start (in the metric for
+        // an anisotropic map), so the worst never drops below the input's.
+        let sopts = tetrefine::SizeOptions {
+            quality_floor: None,
+            improve: tetrefine::ImproveOptions {
+                passes: a.opt_passes,
+                threshold: a.threshold,
+                ..tetrefine::ImproveOptions::default()
+            },
+        };
+        let mut last = None;
+        for s in 1..=n_steps {
+            let t = Instant::now();
+            let r = tetrefine::size_pass(&mut mesh, &mut size, &sopts);
+            let stats = MeshStats::compute(&mesh);
+            let secs = t.elapsed().as_secs_f64();
+            crate::say!("{}", step_row(&format!("size {s}"), &stats, secs));
+            eprintln!(
+                "size pass {s}: {} long edges, {} split, {} refused (would invert a tet or fall below the worst quality so far, measured in the metric), {} still long",
+                r.long_edges, r.split, r.refused, r.long_after
+            );
+            let report = tetrefine::StepReport {
+                seconds: secs,
+                ..tetrefine::StepReport::default()
+            };
+            steps.push(StepStats::step(stats, &report));
+            let done = r.long_after == 0 || r.split == 0;
+            last = Some(r);
+            if done && auto {
+                break;
+            }
+        }
+        if let Some(r) = last {
+            if r.long_after > 0 {
+                let why = if r.split == 0 {
+                    "no split was possible without inverting a tet or falling below the worst quality so far"
+                        .to_string()
+                } else if auto {
+                    format!("--steps auto stops at {n_steps} passes")
+                } else {
+                    format!("--steps {n_steps} passes were run")
+                };
+                eprintln!(
+                    "note: {} edges are still longer than {:.2}× their target: {why}",
+                    r.long_after,
+                    tetrefine::SPLIT_ABOVE
+                );
+            }
+        }
+    } else {
+        let progress = BarProgress::new(n_steps, phases_per_step);
+        refine_with(&mut mesh, n_steps, &opts, &progress, |s, mesh, report| {
+            let stats = MeshStats::compute(mesh);
+            progress.suspend(|| {
             crate::say!("{}", step_row(&format!("step {s}"), &stats, report.seconds));
             if report.refused_flips + report.refused_boundary_flips + report.skipped_moves > 0 {
                 eprintln!(
@@ -304,9 +419,10 @@ pub fn run(a: Args) -> super::CliResult {
                 );
             }
         });
-        steps.push(StepStats::step(stats, &report));
-    });
-    progress.finish();
+            steps.push(StepStats::step(stats, &report));
+        });
+        progress.finish();
+    }
     locate_parents(&input, &mut mesh);
     if let Some(path) = &a.stats {
         let text = serde_json::to_string_pretty(&StatsFile { steps: &steps })

@@ -16,6 +16,7 @@ mod mesh_without_tetgen;
 mod quality;
 mod readme_commands;
 mod refine;
+mod size_map;
 mod strict;
 mod surface;
 mod transfer;
