@@ -143,7 +143,11 @@ impl SizeMap {
     }
 }
 
-/// The symmetric matrix of MMG's `m11 m12 m22 m13 m23 m33`.
+/// The symmetric matrix of MMG's `m11 m12 m22 m13 m23 m33`: the order of
+/// a type-3 solution in a Medit `.sol` (the lower triangle row by row).
+/// MMG's reader (`MMG5_readDoubleSol3D`) swaps the file's slots 2 and 3 into
+/// its internal order `m11 m12 m13 m22 m23 m33`, which confirms the file
+/// order.
 pub fn matrix(m: &[f64; 6]) -> DMat3 {
     DMat3::from_cols(
         DVec3::new(m[0], m[1], m[3]),

@@ -230,11 +230,6 @@ pub fn run(a: Args) -> super::CliResult {
             );
         }
     }
-    if let Some(spec) = &a.indicator {
-        if spec.to_ascii_lowercase().ends_with(".sol") {
-            eprintln!("note: --indicator {spec}: read as an error indicator (larger = refine; SolAtVertices: a tet takes the maximum of its vertices); an MMG size map (target edge lengths) is --size FILE.sol");
-        }
-    }
     if n_steps == 0 && !a.allow_steps_zero {
         return Err("--steps 0 refines nothing; give --steps N ≥ 1 (or --allow-steps-zero to write the mesh unrefined)".into());
     }
@@ -297,7 +292,13 @@ pub fn run(a: Args) -> super::CliResult {
     let selection = match &strategy {
         Some(st) => {
             let values = match &a.indicator {
-                Some(spec) => Some(read_indicator(spec, &input).map_err(|e| e.to_string())?),
+                Some(spec) => {
+                    let v = read_indicator(spec, &input).map_err(|e| e.to_string())?;
+                    if spec.to_ascii_lowercase().ends_with(".sol") {
+                        eprintln!("note: --indicator {spec}: read as an error indicator (larger = refine; SolAtVertices: a tet takes the maximum of its vertices); an MMG size map (target edge lengths) is --size FILE.sol");
+                    }
+                    Some(v)
+                }
                 None => None,
             };
             super::guard::check_selection(st, &input)?;
