@@ -65,7 +65,7 @@ pub use mesh::{
     ball_stays_positive, BuildReport, CheckError, MeshData, MeshError, Remap, TetMesh, Where,
     NO_ADJ,
 };
-pub use ops::OpError;
+pub use ops::{split_edge, OpError};
 pub use polyline::{
     write_feature_lines, write_points_csv, write_points_vtp, write_polylines, write_polylines_csv,
     write_polylines_vtp, PolylineFormat,
@@ -74,9 +74,13 @@ pub use refine::bisect::{bisect, bisect_steps, BisectError};
 pub use refine::features::detect_features;
 pub use refine::marking::{doerfler_count, fraction_count, ranking, select, MarkStrategy};
 pub use refine::parents::{contains, walk_to};
+pub use refine::size::{
+    is_positive_definite, size_pass, worst_quality, SizeMap, SizeOptions, SizeReport, SPLIT_ABOVE,
+};
 pub use refine::{
-    locate_parents, refine, refine_step, refine_step_with_progress, refine_with, refine_with_guard,
-    NoProgress, Phase, PhaseReport, Progress, RefineOptions, StepReport,
+    copy_cell_field, interpolate_point_field, locate_parents, locate_points, refine, refine_step,
+    refine_step_with_progress, refine_with, refine_with_guard, NoProgress, Phase, PhaseReport,
+    PointParent, Progress, RefineOptions, StepReport,
 };
 pub use report::{format_table, write_histogram, MeshStats};
 pub use rng::SplitMix64;

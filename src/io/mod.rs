@@ -25,7 +25,9 @@ pub(crate) mod vtk;
 pub use text::Tokens;
 
 pub use edges::read_edge_list;
-pub use fields::{add_sol_fields, write_point_fields};
+pub use fields::{
+    add_sol_fields, fields_beside, read_size_sol, write_fields_beside, write_point_fields, SizeSol,
+};
 pub use gmsh::MshFormat;
 pub use indicator::{read_indicator, IndicatorSource};
 pub use meshb::{read_sol, write_sol, SolAt, SolFile, Solution};
@@ -38,8 +40,8 @@ pub mod vtp {
     pub use crate::polyline::{write_cells, write_footer, write_header, write_points};
 }
 pub use vtk::{
-    read_noted as read_vtu_noted, read_tet_cell_array, write_vtu, CellArray, TetCellArray,
-    VtuSummary,
+    read_noted as read_vtu_noted, read_tet_cell_array, write_vtu, write_vtu_with, CellArray,
+    PointArray, TetCellArray, VtuSummary, DERIVED_CELL_ARRAYS, DERIVED_POINT_ARRAYS,
 };
 
 pub(crate) use crate::file::open_message;
@@ -243,9 +245,16 @@ pub fn read_mesh_with_meta_noted(
 fn read_mesh_file_with_meta(
     path: &Path,
 ) -> Result<(MeshData, meta::MeshMeta, Vec<String>), IoError> {
-    if Format::for_reading(path)? == Format::Gmsh {
-        let (d, m) = gmsh::read_with_meta(path)?;
-        return Ok((d, m, Vec::new()));
+    match Format::for_reading(path)? {
+        Format::Gmsh => {
+            let (d, m) = gmsh::read_with_meta(path)?;
+            return Ok((d, m, Vec::new()));
+        }
+        Format::Vtu => {
+            let (d, m, n) = vtk::read_with_meta_noted(path)?;
+            return Ok((d, m, n.into_iter().collect()));
+        }
+        _ => {}
     }
     let (d, notes) = read_mesh_file(path)?;
     Ok((d, meta::MeshMeta::default(), notes))

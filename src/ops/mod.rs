@@ -10,6 +10,7 @@
 pub(crate) mod bulk_flip;
 pub(crate) mod bulk_split;
 pub(crate) mod edge_removal;
+pub(crate) mod edge_split;
 pub(crate) mod flip23;
 pub(crate) mod flip32;
 pub(crate) mod flip_repair;
@@ -24,6 +25,7 @@ use crate::topo::TET_FACES;
 pub use bulk_flip::{flip23_bulk, FlipBatch};
 pub use bulk_split::split14_bulk;
 pub use edge_removal::{remove_edge, EdgeRing};
+pub use edge_split::split_edge;
 pub use flip23::{flip23, flip23_tets, flip23_valid};
 pub use flip32::flip32;
 pub use flip_repair::make_flips_valid;

@@ -21,10 +21,13 @@ pub mod bisect;
 pub mod features;
 pub mod marking;
 pub mod parents;
+pub mod size;
 pub mod step;
+pub mod transfer;
 
 pub use parents::locate_parents;
 pub use step::{refine, refine_step, refine_step_with_progress, refine_with, refine_with_guard};
+pub use transfer::{copy_cell_field, interpolate_point_field, locate_points, PointParent};
 
 /// Progress callbacks for long phases (the CLI draws bars with them).
 /// Every method has a no-op default.

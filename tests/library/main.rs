@@ -14,3 +14,4 @@ mod ops_proptest;
 mod refine_counts;
 mod refine_meshes;
 mod refine_quality;
+mod transfer;

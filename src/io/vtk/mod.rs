@@ -33,8 +33,11 @@ mod read;
 mod write;
 mod xml;
 
-pub use read::{read_noted, read_tet_cell_array, TetCellArray};
-pub use write::{write_vtu, CellArray, VtuSummary};
+pub use read::{
+    read_noted, read_tet_cell_array, read_with_meta_noted, TetCellArray, DERIVED_CELL_ARRAYS,
+    DERIVED_POINT_ARRAYS,
+};
+pub use write::{write_vtu, write_vtu_with, CellArray, PointArray, VtuSummary};
 
 /// VTK's cell type of a linear tetrahedron.
 const VTK_TETRA: u8 = 10;

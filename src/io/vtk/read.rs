@@ -620,3 +620,138 @@ fn read_piece(
     }
     Ok(())
 }
+
+/// Arrays a `.vtu` written by tetrefine carries that the writer computes
+/// afresh (mesh quality, refinement bookkeeping, the vertex parent map) or
+/// that give the regions: not fields of the solver, so not read as fields.
+pub const DERIVED_POINT_ARRAYS: [&str; 5] = [
+    "valence",
+    "parent_tet",
+    "parent_vertices",
+    "parent_bary",
+    "parent_outside",
+];
+/// See [`DERIVED_POINT_ARRAYS`]; the last four are the region arrays.
+pub const DERIVED_CELL_ARRAYS: [&str; 12] = [
+    "min_dihedral",
+    "max_dihedral",
+    "quality",
+    "volume",
+    "level",
+    "parent",
+    "marked",
+    "region",
+    "gmsh:physical",
+    "medit:ref",
+    "CellEntityIds",
+    "gmsh:geometrical",
+];
+
+/// [`read_noted`] with the point and cell arrays of the file as fields
+/// ([`MeshMeta::point_fields`](crate::io::meta::MeshMeta),
+/// `cell_fields`; cell arrays at the tetrahedra only, in the order [`read`]
+/// lists them), except the arrays tetrefine derives ([`DERIVED_POINT_ARRAYS`],
+/// [`DERIVED_CELL_ARRAYS`]). With several pieces, an array must be in every
+/// piece with the same number of components. Every value must be finite: a
+/// NaN or an infinity is an error naming the array's line.
+pub fn read_with_meta_noted(
+    path: &Path,
+) -> Result<(MeshData, crate::io::meta::MeshMeta, Option<String>), IoError> {
+    use crate::io::meta::{Field, MeshMeta};
+    let (data, note) = read_noted(path)?;
+    let meta = with_pieces(path, |layout, elems, pieces| {
+        // name → (components, values, pieces seen)
+        let mut point: Vec<(String, usize, Vec<f64>, usize)> = Vec::new();
+        let mut cell: Vec<(String, usize, Vec<f64>, usize)> = Vec::new();
+        for (k, piece) in pieces.iter().enumerate() {
+            let np = count_attr(path, piece, "NumberOfPoints")?;
+            let nc = count_attr(path, piece, "NumberOfCells")?;
+            let types: Vec<i64> = match child_element(elems, piece, "Cells").and_then(|c| {
+                data_arrays(elems, c)
+                    .into_iter()
+                    .find(|a| a.attr("Name") == Some("types"))
+            }) {
+                Some(a) => match layout.values(a)?.0 {
+                    Values::Ints(v) => v,
+                    Values::Floats(_) => Vec::new(),
+                },
+                None => Vec::new(),
+            };
+            for (section, n, skip, out) in [
+                ("PointData", np, &DERIVED_POINT_ARRAYS[..], &mut point),
+                ("CellData", nc, &DERIVED_CELL_ARRAYS[..], &mut cell),
+            ] {
+                let Some(sec) = child_element(elems, piece, section) else {
+                    continue;
+                };
+                for a in data_arrays(elems, sec) {
+                    let Some(name) = a.attr("Name") else { continue };
+                    if skip.contains(&name) {
+                        continue;
+                    }
+                    let (values, comps) = layout.values(a)?;
+                    if values.len() != n * comps {
+                        return Err(IoError::at(
+                            path,
+                            a.line,
+                            format!(
+                                "{section} array '{name}' holds {} values for {n} entries of {comps} components",
+                                values.len()
+                            ),
+                        ));
+                    }
+                    let mut v: Vec<f64> = match values {
+                        Values::Floats(v) => v,
+                        Values::Ints(v) => v.into_iter().map(|x| x as f64).collect(),
+                    };
+                    if let Some(i) = v.iter().position(|x| !x.is_finite()) {
+                        return Err(IoError::at(
+                            path,
+                            a.line,
+                            format!(
+                                "{section} array '{name}': value {} of entry {} is not a finite number",
+                                v[i],
+                                i / comps + 1
+                            ),
+                        ));
+                    }
+                    if section == "CellData" {
+                        // Keep the tetrahedra's values, as `read` keeps the tets.
+                        v = types
+                            .iter()
+                            .enumerate()
+                            .filter(|&(_, &ty)| ty == VTK_TETRA as i64)
+                            .flat_map(|(c, _)| v[c * comps..(c + 1) * comps].to_vec())
+                            .collect();
+                    }
+                    match out.iter_mut().find(|e| e.0 == name) {
+                        Some(e) if e.1 == comps && e.3 == k => {
+                            e.2.extend(v);
+                            e.3 += 1;
+                        }
+                        Some(_) => {}
+                        None if k == 0 => out.push((name.to_string(), comps, v, 1)),
+                        None => {}
+                    }
+                }
+            }
+        }
+        let n = pieces.len();
+        let keep = |v: Vec<(String, usize, Vec<f64>, usize)>| -> Vec<Field> {
+            v.into_iter()
+                .filter(|e| e.3 == n)
+                .map(|(name, components, values, _)| Field {
+                    name,
+                    components,
+                    values,
+                })
+                .collect()
+        };
+        Ok(MeshMeta {
+            point_fields: keep(point),
+            cell_fields: keep(cell),
+            ..MeshMeta::default()
+        })
+    })?;
+    Ok((data, meta, note))
+}

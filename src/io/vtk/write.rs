@@ -23,13 +23,41 @@ pub enum CellArray<'a> {
     /// when it is written (the `i`-th live tet's): a 14M-tet mesh's arrays
     /// are 56 MB each, which a writer streaming blocks need not hold.
     Int32With(String, usize, &'a (dyn Fn(usize) -> i32 + Sync)),
+    /// A 64-bit float array of several components per tet: name,
+    /// components, values (tet after tet).
+    Float64Components(String, usize, Vec<f64>),
+}
+
+/// An extra per-point array for [`write_vtu_with`]: a name, components per
+/// point, and the values point after point (`components` × points).
+#[derive(Clone, Debug, PartialEq)]
+pub enum PointArray {
+    /// 64-bit floats.
+    Float64(String, usize, Vec<f64>),
+    /// 32-bit integers: name, components, values.
+    Int32(String, usize, Vec<i32>),
+}
+
+impl PointArray {
+    fn name(&self) -> &str {
+        match self {
+            PointArray::Float64(n, ..) | PointArray::Int32(n, ..) => n,
+        }
+    }
+
+    fn entries(&self) -> usize {
+        match self {
+            PointArray::Float64(_, c, v) => v.len() / (*c).max(1),
+            PointArray::Int32(_, c, v) => v.len() / (*c).max(1),
+        }
+    }
 }
 
 impl std::fmt::Debug for CellArray<'_> {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         let kind = match self {
             CellArray::Int32(..) | CellArray::Int32With(..) => "Int32",
-            CellArray::Float64(..) => "Float64",
+            CellArray::Float64(..) | CellArray::Float64Components(..) => "Float64",
         };
         write!(
             f,
@@ -43,7 +71,10 @@ impl std::fmt::Debug for CellArray<'_> {
 impl CellArray<'_> {
     fn name(&self) -> &str {
         match self {
-            CellArray::Int32(n, _) | CellArray::Float64(n, _) | CellArray::Int32With(n, ..) => n,
+            CellArray::Int32(n, _)
+            | CellArray::Float64(n, _)
+            | CellArray::Int32With(n, ..)
+            | CellArray::Float64Components(n, ..) => n,
         }
     }
 
@@ -52,6 +83,7 @@ impl CellArray<'_> {
             CellArray::Int32(_, v) => v.len(),
             CellArray::Float64(_, v) => v.len(),
             CellArray::Int32With(_, n, _) => *n,
+            CellArray::Float64Components(_, c, v) => v.len() / (*c).max(1),
         }
     }
 }
@@ -165,6 +197,17 @@ fn compressed_array<T: LeBytes + Send>(
     Ok(())
 }
 
+/// The `NumberOfComponents` attribute of an array of `c` components: none
+/// for a scalar, which readers (meshio) then give as a plain array rather
+/// than one of `n × 1`.
+fn components_attr(c: usize) -> String {
+    if c == 1 {
+        String::new()
+    } else {
+        format!(" NumberOfComponents=\"{c}\"")
+    }
+}
+
 /// One `<DataArray>` element of `n` values `value(i)` (see [`compressed_array`]).
 fn data_array<T: LeBytes + Send>(
     w: &mut dyn Write,
@@ -200,6 +243,41 @@ pub fn write_vtu(
     summary: Option<&VtuSummary>,
     extra_cells: &[CellArray],
 ) -> Result<(), IoError> {
+    write_vtu_with(path, mesh, summary, extra_cells, &[])
+}
+
+/// [`write_vtu`] with extra point arrays (transferred fields, the vertex
+/// parent map): one entry per point, names different from `valence` and
+/// from each other.
+pub fn write_vtu_with(
+    path: &Path,
+    mesh: &TetMesh,
+    summary: Option<&VtuSummary>,
+    extra_cells: &[CellArray],
+    extra_points: &[PointArray],
+) -> Result<(), IoError> {
+    for (i, a) in extra_points.iter().enumerate() {
+        if a.entries() != mesh.n_points()
+            || matches!(a, PointArray::Float64(_, c, v) if *c == 0 || v.len() % c != 0)
+            || matches!(a, PointArray::Int32(_, c, v) if *c == 0 || v.len() % c != 0)
+        {
+            return Err(IoError::file(
+                path,
+                format!(
+                    "point array '{}' has {} entries for {} points",
+                    a.name(),
+                    a.entries(),
+                    mesh.n_points()
+                ),
+            ));
+        }
+        if a.name() == "valence" || extra_points[..i].iter().any(|b| b.name() == a.name()) {
+            return Err(IoError::file(
+                path,
+                format!("point array name '{}' is used twice", a.name()),
+            ));
+        }
+    }
     let n_tets = mesh.n_tets();
     for (i, a) in extra_cells.iter().enumerate() {
         if a.len() != n_tets {
@@ -273,10 +351,25 @@ pub fn write_vtu(
             "    <Piece NumberOfPoints=\"{}\" NumberOfCells=\"{n_tets}\">",
             mesh.n_points(),
         )?;
-        if let Some(s) = summary {
-            let valence = s.valence;
-            writeln!(w, "      <PointData Scalars=\"valence\">")?;
-            data_array(w, "valence", valence.len(), "", |i| valence[i] as i32)?;
+        if summary.is_some() || !extra_points.is_empty() {
+            match summary {
+                Some(_) => writeln!(w, "      <PointData Scalars=\"valence\">")?,
+                None => writeln!(w, "      <PointData>")?,
+            }
+            if let Some(s) = summary {
+                let valence = s.valence;
+                data_array(w, "valence", valence.len(), "", |i| valence[i] as i32)?;
+            }
+            for a in extra_points {
+                match a {
+                    PointArray::Float64(n, c, v) => {
+                        data_array(w, n, v.len(), &components_attr(*c), |i| v[i])?
+                    }
+                    PointArray::Int32(n, c, v) => {
+                        data_array(w, n, v.len(), &components_attr(*c), |i| v[i])?
+                    }
+                }
+            }
             writeln!(w, "      </PointData>")?;
         }
         writeln!(w, "      <CellData Scalars=\"region\">")?;
@@ -296,6 +389,9 @@ pub fn write_vtu(
                 CellArray::Int32(n, v) => data_array(w, n, v.len(), "", |i| v[i])?,
                 CellArray::Float64(n, v) => data_array(w, n, v.len(), "", |i| v[i])?,
                 CellArray::Int32With(n, len, f) => data_array(w, n, *len, "", f)?,
+                CellArray::Float64Components(n, c, v) => {
+                    data_array(w, n, v.len(), &components_attr(*c), |i| v[i])?
+                }
             }
         }
         writeln!(w, "      </CellData>\n      <Points>")?;

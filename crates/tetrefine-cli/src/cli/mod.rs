@@ -10,11 +10,13 @@ pub mod outputs;
 pub mod progress;
 pub mod quality;
 pub mod refine;
+pub mod size;
 pub mod steps;
 pub mod surface;
+pub mod transfer;
 
 use std::path::Path;
-use tetrefine::io::{CellArray, VtuSummary};
+use tetrefine::io::{CellArray, PointArray, VtuSummary};
 use tetrefine::report::MeshStats;
 use tetrefine::report::{write_histogram as write_hist_file, HistogramFormat};
 use tetrefine::TetMesh;
@@ -84,15 +86,18 @@ pub fn write_histogram(path: &Path, stats: &MeshStats) -> CliResult {
 pub type TetValue<'a> = dyn Fn(&TetMesh, u32) -> i32 + Sync + 'a;
 
 /// Writes a refined mesh: compacted, and for `.vtu` with the cell arrays
-/// `level` and `parent` (plus `extra`, named integers per tet) besides the
+/// `level` and `parent` (plus `extra`, named integers per tet, and
+/// `arrays`: transferred fields and the vertex parent map) besides the
 /// standard quality arrays; other formats get the input's side table `meta`
-/// (physical names and tags) and the write `options` (the MSH variant).
+/// (physical names and tags, fields for Gmsh) and the write `options` (the
+/// MSH variant); a Medit output gets its fields in `.sol` files beside it.
 pub fn write_refined(
     path: &Path,
     mesh: &mut TetMesh,
     extra: &[(&str, &TetValue<'_>)],
     meta: &tetrefine::io::MeshMeta,
     options: &tetrefine::io::WriteOptions,
+    arrays: (Vec<PointArray>, Vec<CellArray<'static>>),
 ) -> CliResult {
     mesh.compact();
     let is_vtu = path
@@ -119,11 +124,33 @@ pub fn write_refined(
                 .iter()
                 .map(|(name, f)| CellArray::Int32With(name.to_string(), n, f)),
         );
+        let (points, field_cells) = arrays;
+        cells.extend(field_cells);
         let (valence, stats) = (MeshStats::vertex_valence(mesh), MeshStats::compute(mesh));
         let summary = vtu_summary(&valence, &stats);
-        tetrefine::io::write_vtu(path, mesh, Some(&summary), &cells).map_err(|e| e.to_string())
+        tetrefine::io::write_vtu_with(path, mesh, Some(&summary), &cells, &points)
+            .map_err(|e| e.to_string())
     } else {
-        tetrefine::io::write_mesh_with(path, mesh, meta, options).map_err(|e| e.to_string())
+        tetrefine::io::write_mesh_with(path, mesh, meta, options).map_err(|e| e.to_string())?;
+        let (_written, skipped) =
+            tetrefine::io::write_fields_beside(path, meta, mesh.n_points(), mesh.n_tets())
+                .map_err(|e| e.to_string())?;
+        if !skipped.is_empty() {
+            eprintln!(
+                "note: {}: fields {} not written (a Medit solution holds 1, 3, 6 or 9 components)",
+                path.display(),
+                skipped.join(", ")
+            );
+        }
+        let has_fields = !meta.point_fields.is_empty() || !meta.cell_fields.is_empty();
+        let fmt = tetrefine::io::Format::for_writing(path).map_err(|e| e.to_string())?;
+        if has_fields && fmt == tetrefine::io::Format::Tetgen {
+            eprintln!(
+                "note: {}: TetGen files carry no fields; write .vtu, .msh or .mesh to keep them",
+                path.display()
+            );
+        }
+        Ok(())
     }
 }
 

@@ -25,9 +25,28 @@ pub struct Args {
     /// Output mesh (.vtu, .mesh, .msh, .node).
     #[arg(short, long)]
     pub output: PathBuf,
-    /// Number of √3 steps.
-    #[arg(long, default_value_t = 1)]
-    pub steps: usize,
+    /// Number of √3 steps (default 1); with a size map, of size passes, or
+    /// `auto`: passes until no edge is longer than its target (at most 20;
+    /// the default with a size map).
+    #[arg(long)]
+    pub steps: Option<super::size::Steps>,
+    /// MMG size map: a Medit `.sol` with SolAtVertices of type 1 (a target
+    /// edge length per point) or type 3 (a metric per point, MMG's order
+    /// m11 m12 m22 m13 m23 m33). Refines by splitting every edge longer
+    /// than its target instead of √3 steps.
+    #[arg(long)]
+    pub size: Option<PathBuf>,
+    /// The size map is this point array of the input (`.vtu` point data or
+    /// Gmsh `$NodeData`; 1 component: a length, 6: a metric).
+    #[arg(long)]
+    pub size_array: Option<String>,
+    /// A uniform target edge length (MMG's -hsiz).
+    #[arg(long)]
+    pub hsiz: Option<f64>,
+    /// The largest target edge length (MMG's -hmax): caps the size map, or
+    /// alone is a uniform target.
+    #[arg(long)]
+    pub hmax: Option<f64>,
     /// Boundary rule: interpolating (Labsik–Greiner), approximating (Kobbelt) or linear.
     #[arg(long, default_value = "interpolating")]
     pub boundary: Sqrt3Rule,
@@ -83,10 +102,29 @@ pub struct Args {
     /// out bit-identical; `all` optimises everywhere.
     #[arg(long, default_value = "refined")]
     pub smooth: SmoothScope,
-    /// Write `new_tet parent_tet` per line (0-based output and input ids), so
-    /// a solver can carry its fields over.
+    /// Write `new_tet parent_tet` per line (0-based output and input ids),
+    /// then, after a `# points` line, the vertex parent map: per output
+    /// point `new_point input_tet v0 v1 v2 v3 b0 b1 b2 b3 outside` (the
+    /// input tet holding it, its vertices and the point's barycentric
+    /// coordinates), so a solver can carry its fields over.
     #[arg(long)]
     pub parent_map: Option<PathBuf>,
+    /// Carry the input's fields over (the default when it has any: `.vtu`
+    /// point and cell data, Gmsh `$NodeData`, `--fields`): point fields
+    /// interpolated linearly in the input tet holding each output point,
+    /// cell fields copied from each tet's parent.
+    #[arg(long, overrides_with = "no_transfer")]
+    pub transfer: bool,
+    /// Drop the input's fields instead of carrying them over.
+    #[arg(long, overrides_with = "transfer")]
+    pub no_transfer: bool,
+    /// Point or cell fields of the input from a Medit solution (.sol or
+    /// .solb: SolAtVertices → point fields, SolAtTetrahedra → cell fields);
+    /// repeatable. Written as `.vtu` point/cell data, Gmsh
+    /// `$NodeData`/`$ElementData`, or `OUT.sol` (points) and `OUT.tets.sol`
+    /// (tets) beside a `.mesh` output.
+    #[arg(long)]
+    pub fields: Vec<PathBuf>,
     /// Refinement rounds already done on this mesh (in an adaptive loop,
     /// the round number): feature edges are kept in odd and trisected in
     /// even global steps.
@@ -160,7 +198,39 @@ pub fn run(a: Args) -> super::CliResult {
         ("--features-out", a.features_out.as_deref()),
         ("--parent-map", a.parent_map.as_deref()),
     ])?;
-    if a.steps == 0 && !a.allow_steps_zero {
+    let size_given =
+        a.size.is_some() || a.size_array.is_some() || a.hsiz.is_some() || a.hmax.is_some();
+    let n_steps = match (a.steps, size_given) {
+        (Some(super::size::Steps::N(n)), _) => n,
+        (None, false) => 1,
+        (None, true) | (Some(super::size::Steps::Auto), true) => super::size::AUTO_CAP,
+        (Some(super::size::Steps::Auto), false) => {
+            return Err("--steps auto refines until every edge meets a size map: give --size FILE.sol, --size-array NAME, --hsiz H or --hmax H".into())
+        }
+    };
+    let auto = size_given && a.steps.is_none_or(|s| s == super::size::Steps::Auto);
+    if size_given {
+        if let Some(p) = &a.size {
+            super::outputs::refuse_shared_paths(&[
+                ("-o", Some(a.output.as_path())),
+                ("--size", Some(p.as_path())),
+            ])?;
+        }
+        if a.indicator.is_some()
+            || !a.marks.is_empty()
+            || a.region.is_some()
+            || a.select_box.is_some()
+            || a.sphere.is_some()
+        {
+            return Err("a size map chooses what to refine itself: drop --indicator/--mark/--region/--box/--sphere, or the size options".into());
+        }
+        if a.stop_after.is_some() {
+            return Err(
+                "--stop-after names a phase of the √3 step; size-driven refinement has none".into(),
+            );
+        }
+    }
+    if n_steps == 0 && !a.allow_steps_zero {
         return Err("--steps 0 refines nothing; give --steps N ≥ 1 (or --allow-steps-zero to write the mesh unrefined)".into());
     }
     let budget = super::guard::MemoryBudget::new(a.max_memory.as_deref())?;
@@ -183,11 +253,52 @@ pub fn run(a: Args) -> super::CliResult {
         tetrefine::PolylineFormat::of(f).map_err(|e| e.to_string())?;
     }
     let strategy = mark_strategy(&a)?;
-    let (mut input, meta) = super::load_with_meta(&a.input)?;
+    let (mut input, mut meta) = super::load_with_meta(&a.input)?;
+    for f in &a.fields {
+        tetrefine::io::add_sol_fields(f, &mut meta, input.n_points(), input.n_tets())
+            .map_err(|e| e.to_string())?;
+    }
+    let has_fields = !meta.point_fields.is_empty() || !meta.cell_fields.is_empty();
+    if a.transfer && !a.no_transfer && !has_fields {
+        return Err(format!(
+            "--transfer: {} carries no point or cell field (give one with --fields FILE.sol)",
+            a.input.display()
+        ));
+    }
+    let transfer = has_fields && !a.no_transfer;
+    if transfer {
+        let beside = tetrefine::io::fields_beside(&a.output);
+        super::outputs::refuse_shared_paths(&[
+            ("-o", Some(a.output.as_path())),
+            ("--stats", a.stats.as_deref()),
+            ("--histogram", a.histogram.as_deref()),
+            ("--features-out", a.features_out.as_deref()),
+            ("--parent-map", a.parent_map.as_deref()),
+            (
+                "the point fields beside -o",
+                beside.as_ref().map(|b| b.0.as_path()),
+            ),
+            (
+                "the cell fields beside -o",
+                beside.as_ref().map(|b| b.1.as_path()),
+            ),
+        ])?;
+        eprintln!(
+            "transfer: {} point and {} cell fields of the input",
+            meta.point_fields.len(),
+            meta.cell_fields.len()
+        );
+    }
     let selection = match &strategy {
         Some(st) => {
             let values = match &a.indicator {
-                Some(spec) => Some(read_indicator(spec, &input).map_err(|e| e.to_string())?),
+                Some(spec) => {
+                    let v = read_indicator(spec, &input).map_err(|e| e.to_string())?;
+                    if spec.to_ascii_lowercase().ends_with(".sol") {
+                        eprintln!("note: --indicator {spec}: read as an error indicator (larger = refine; SolAtVertices: a tet takes the maximum of its vertices); an MMG size map (target edge lengths) is --size FILE.sol");
+                    }
+                    Some(v)
+                }
                 None => None,
             };
             super::guard::check_selection(st, &input)?;
@@ -209,12 +320,20 @@ pub fn run(a: Args) -> super::CliResult {
         .as_ref()
         .map_or(input.n_tets(), |s| s.iter().filter(|&&x| x).count()) as u64;
     budget.check_plan(
-        a.steps,
+        if size_given { 1 } else { n_steps },
         input.n_tets() as u64,
         selected,
         input.n_tets() as u64,
     )?;
     super::apply_feature_option(&mut input, &a.features, a.feature_angle)?;
+    let size = super::size::size_map(
+        a.size.as_deref(),
+        a.size_array.as_deref(),
+        a.hsiz,
+        a.hmax,
+        &input,
+        &meta,
+    )?;
     let mut mesh = input.clone();
     let opts = RefineOptions {
         boundary: a.boundary,
@@ -238,23 +357,74 @@ pub fn run(a: Args) -> super::CliResult {
             .map_or(Phase::ALL.len(), |i| i + 1),
         None => Phase::ALL.len(),
     };
-    let progress = BarProgress::new(a.steps, phases_per_step);
-    // The plan above projected every step; before each step its real tet
-    // counts are held against the budget again (a step of a mesh that grew
-    // more than projected is refused, naming it, with nothing written).
-    let kept = input.n_tets() as u64;
-    let before_step = |s: usize, mesh: &tetrefine::TetMesh, split: u64| {
-        budget.check_step(s, mesh.n_tets() as u64, split, kept)
-    };
-    tetrefine::refine_with_guard(
-        &mut mesh,
-        a.steps,
-        &opts,
-        &progress,
-        before_step,
-        |s, mesh, report| {
-            let stats = MeshStats::compute(mesh);
-            progress.suspend(|| {
+    if let Some(mut size) = size {
+        // The floor: each pass's worst tet at its start (in the metric for
+        // an anisotropic map), so the worst never drops below the input's.
+        let sopts = tetrefine::SizeOptions {
+            quality_floor: None,
+            improve: tetrefine::ImproveOptions {
+                passes: a.opt_passes,
+                threshold: a.threshold,
+                ..tetrefine::ImproveOptions::default()
+            },
+        };
+        let mut last = None;
+        for s in 1..=n_steps {
+            let t = Instant::now();
+            let r = tetrefine::size_pass(&mut mesh, &mut size, &sopts);
+            let stats = MeshStats::compute(&mesh);
+            let secs = t.elapsed().as_secs_f64();
+            crate::say!("{}", step_row(&format!("size {s}"), &stats, secs));
+            eprintln!(
+                "size pass {s}: {} long edges, {} split, {} refused (would invert a tet or fall below the worst quality so far, measured in the metric), {} still long",
+                r.long_edges, r.split, r.refused, r.long_after
+            );
+            let report = tetrefine::StepReport {
+                seconds: secs,
+                ..tetrefine::StepReport::default()
+            };
+            steps.push(StepStats::step(stats, &report));
+            let done = r.long_after == 0 || r.split == 0;
+            last = Some(r);
+            if done && auto {
+                break;
+            }
+        }
+        if let Some(r) = last {
+            if r.long_after > 0 {
+                let why = if r.split == 0 {
+                    "no split was possible without inverting a tet or falling below the worst quality so far"
+                        .to_string()
+                } else if auto {
+                    format!("--steps auto stops at {n_steps} passes")
+                } else {
+                    format!("--steps {n_steps} passes were run")
+                };
+                eprintln!(
+                    "note: {} edges are still longer than {:.2}× their target: {why}",
+                    r.long_after,
+                    tetrefine::SPLIT_ABOVE
+                );
+            }
+        }
+    } else {
+        let progress = BarProgress::new(n_steps, phases_per_step);
+        // The plan above projected every step; before each step its real tet
+        // counts are held against the budget again (a step of a mesh that grew
+        // more than projected is refused, naming it, with nothing written).
+        let kept = input.n_tets() as u64;
+        let before_step = |s: usize, mesh: &tetrefine::TetMesh, split: u64| {
+            budget.check_step(s, mesh.n_tets() as u64, split, kept)
+        };
+        tetrefine::refine_with_guard(
+            &mut mesh,
+            n_steps,
+            &opts,
+            &progress,
+            before_step,
+            |s, mesh, report| {
+                let stats = MeshStats::compute(mesh);
+                progress.suspend(|| {
             crate::say!("{}", step_row(&format!("step {s}"), &stats, report.seconds));
             if report.refused_flips + report.refused_boundary_flips + report.skipped_moves > 0 {
                 eprintln!(
@@ -263,10 +433,11 @@ pub fn run(a: Args) -> super::CliResult {
                 );
             }
         });
-            steps.push(StepStats::step(stats, &report));
-        },
-    )?;
-    progress.finish();
+                steps.push(StepStats::step(stats, &report));
+            },
+        )?;
+        progress.finish();
+    }
     locate_parents(&input, &mut mesh);
     if let Some(path) = &a.stats {
         let text = serde_json::to_string_pretty(&StatsFile { steps: &steps })
@@ -275,20 +446,12 @@ pub fn run(a: Args) -> super::CliResult {
             .map_err(|e| e.to_string())?;
     }
     mesh.compact();
-    if let Some(path) = &a.parent_map {
-        let ids: Vec<u32> = mesh.tet_ids().collect();
-        tetrefine::io::write_atomic(path, |w| {
-            use std::io::Write;
-            writeln!(
-                w,
-                "# new_tet parent_tet (0-based; parent = input tet holding the centroid)"
-            )?;
-            for (i, &t) in ids.iter().enumerate() {
-                writeln!(w, "{i} {}", mesh.parent(t))?;
-            }
-            Ok(())
-        })
-        .map_err(|e| e.to_string())?;
+    let is_vtu = tetrefine::io::Format::for_writing(&a.output).map_err(|e| e.to_string())?
+        == tetrefine::io::Format::Vtu;
+    let locations = (transfer || is_vtu || a.parent_map.is_some())
+        .then(|| tetrefine::locate_points(&input, &mesh));
+    if let (Some(path), Some(locs)) = (&a.parent_map, &locations) {
+        super::transfer::write_parent_map(path, &input, &mesh, locs)?;
     }
     // Whether the tet descends from a selected input tet (all do without a
     // selection).
@@ -301,16 +464,25 @@ pub fn run(a: Args) -> super::CliResult {
         msh_format: a.msh_format,
     };
     // Names and tag lists stay valid through refinement (every child keeps its
-    // parent's region and markers); the input's fields do not.
-    let mut meta = meta;
-    meta.point_fields.clear();
-    meta.cell_fields.clear();
+    // parent's region and markers); the fields are carried over or dropped.
+    let (point_fields, cell_fields) = match (&locations, transfer) {
+        (Some(locs), true) => super::transfer::transfer_fields(&input, &mesh, &meta, locs),
+        _ => (Vec::new(), Vec::new()),
+    };
+    let arrays = if is_vtu {
+        super::transfer::vtu_arrays(&input, locations.as_deref(), &point_fields, &cell_fields)
+    } else {
+        (Vec::new(), Vec::new())
+    };
+    meta.point_fields = point_fields;
+    meta.cell_fields = cell_fields;
     super::write_refined(
         &a.output,
         &mut mesh,
         &[("marked", &marked)],
         &meta,
         &options,
+        arrays,
     )?;
     if let Some(f) = &a.features_out {
         super::write_feature_lines(f, &mesh)?;

@@ -159,7 +159,9 @@ fn parent_holds_the_centroid_and_level_counts_refinements() {
     let sel = top_284(&input);
     let touched: HashSet<u32> = sel.iter().flat_map(|&t| input.tet(t)).collect();
     let map_text = std::fs::read_to_string(&map).unwrap();
-    let map_rows: Vec<(usize, u32)> = map_text
+    // The tet section, before the vertex parent map.
+    let (tet_section, _) = map_text.split_once("# points").expect("a points section");
+    let map_rows: Vec<(usize, u32)> = tet_section
         .lines()
         .filter(|l| !l.starts_with('#'))
         .map(|l| {

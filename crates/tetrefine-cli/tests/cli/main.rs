@@ -16,8 +16,10 @@ mod mesh_without_tetgen;
 mod quality;
 mod readme_commands;
 mod refine;
+mod size_map;
 mod strict;
 mod surface;
+mod transfer;
 
 use std::process::Command;
 

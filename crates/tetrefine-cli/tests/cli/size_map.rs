@@ -1,0 +1,333 @@
+//! `refine` with MMG size maps (issue 17, point 2): `--size FILE.sol`
+//! (scalar sizes and 6-component metrics in MMG's order), `--hsiz`,
+//! `--hmax`, `--size-array`, `--steps auto`. The output is read back and
+//! every edge measured here against the closed-form size; counts are held
+//! against the size map's own prediction (volume over the volume of a
+//! regular tet of edge h); quality is held against the input's.
+
+use std::path::Path;
+use tetrefine::{load_mesh, write_mesh, MeshStats, TetMesh};
+
+fn tetrefine(args: &[&str]) -> std::process::Output {
+    crate::tetrefine_command().args(args).output().unwrap()
+}
+
+fn ok(args: &[&str]) -> std::process::Output {
+    let o = tetrefine(args);
+    assert!(
+        o.status.success(),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    o
+}
+
+fn files_in(dir: &Path) -> Vec<String> {
+    let mut v: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    v.sort();
+    v
+}
+
+/// A 4×4×4 block of unit cubes, six tets each, written as `.mesh`.
+fn block(dir: &Path) -> (String, TetMesh) {
+    let data = crate::support::kuhn_grid(4, 4, 4);
+    let mesh = TetMesh::from_data(&data).unwrap().0;
+    let p = dir.join("block.mesh");
+    write_mesh(&p, &mesh).unwrap();
+    (p.to_str().unwrap().to_string(), mesh)
+}
+
+/// The distinct edges of a mesh as point pairs.
+fn edges(m: &TetMesh) -> Vec<([f64; 3], [f64; 3])> {
+    let mut e: Vec<[u32; 2]> = m
+        .tet_ids()
+        .flat_map(|t| {
+            let v = m.tet(t);
+            [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)].map(|(i, j)| {
+                let (a, b) = (v[i].min(v[j]), v[i].max(v[j]));
+                [a, b]
+            })
+        })
+        .collect();
+    e.sort_unstable();
+    e.dedup();
+    e.iter()
+        .map(|&[a, b]| (m.point(a).to_array(), m.point(b).to_array()))
+        .collect()
+}
+
+fn write_sol(path: &Path, ty: u8, rows: &[Vec<f64>]) {
+    let mut s = format!(
+        "MeshVersionFormatted 2\n\nDimension 3\n\nSolAtVertices\n{}\n1 {ty}\n",
+        rows.len()
+    );
+    for r in rows {
+        let line: Vec<String> = r.iter().map(|x| format!("{x:?}")).collect();
+        s += &line.join(" ");
+        s += "\n";
+    }
+    s += "\nEnd\n";
+    std::fs::write(path, s).unwrap();
+}
+
+fn norm(d: [f64; 3]) -> f64 {
+    (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt()
+}
+
+fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+/// A size linear in x: 0.35 at x = 0 up to 0.95 at x = 4.
+fn h(p: [f64; 3]) -> f64 {
+    0.35 + 0.15 * p[0]
+}
+
+#[test]
+fn a_scalar_size_map_is_met_with_about_the_predicted_count_and_no_quality_loss() {
+    let inputs = tempfile::tempdir().unwrap();
+    let (mesh_path, input) = block(inputs.path());
+    let rows: Vec<Vec<f64>> = input
+        .points()
+        .iter()
+        .map(|p| vec![h(p.to_array())])
+        .collect();
+    let sol = inputs.path().join("size.sol");
+    write_sol(&sol, 1, &rows);
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("o.mesh");
+    ok(&[
+        "refine",
+        &mesh_path,
+        "-o",
+        out.to_str().unwrap(),
+        "--size",
+        sol.to_str().unwrap(),
+    ]);
+    let (m, _) = load_mesh(&out).unwrap();
+    m.check().unwrap();
+    // Every edge at most 1.5 times its target, in the mean of the two
+    // ends' sizes (the size is linear: this is the size at the midpoint).
+    let mut worst = 0.0f64;
+    for (a, b) in edges(&m) {
+        let l = norm(sub(b, a)) * 0.5 * (1.0 / h(a) + 1.0 / h(b));
+        worst = worst.max(l);
+    }
+    assert!(worst <= 1.5, "an edge is {worst:.3} times its target");
+    // The prediction: ∫ dV / (h³ / (6√2)) over the block, h depending on x
+    // only: 16 · 6√2 · ∫₀⁴ dx / h(x)³.
+    let n = 100_000;
+    let integral: f64 = (0..n)
+        .map(|i| {
+            let x = 4.0 * (i as f64 + 0.5) / n as f64;
+            4.0 / n as f64 / h([x, 0.0, 0.0]).powi(3)
+        })
+        .sum();
+    let predicted = 16.0 * 6.0 * 2f64.sqrt() * integral;
+    let ratio = m.n_tets() as f64 / predicted;
+    // Edges end up between 1/√2 and √2 of their target, not all at it: the
+    // count lies within a factor 2.5 of the prediction either way.
+    assert!(
+        (0.4..=2.5).contains(&ratio),
+        "{} tets for a predicted {predicted:.0} (ratio {ratio:.2})",
+        m.n_tets()
+    );
+    let (s_in, s_out) = (MeshStats::compute(&input), MeshStats::compute(&m));
+    assert_eq!(s_out.inverted, 0);
+    assert!(
+        s_out.min_dihedral_deg.worst >= s_in.min_dihedral_deg.worst - 1e-9,
+        "worst minimum dihedral {} below the input's {}",
+        s_out.min_dihedral_deg.worst,
+        s_in.min_dihedral_deg.worst
+    );
+}
+
+#[test]
+fn an_anisotropic_metric_refines_one_direction_only() {
+    let inputs = tempfile::tempdir().unwrap();
+    let (mesh_path, input) = block(inputs.path());
+    let hx = 0.3;
+    // m11 m12 m22 m13 m23 m33: 1/hx² along x, nearly nothing along y and z.
+    let m = vec![1.0 / (hx * hx), 0.0, 1e-6, 0.0, 0.0, 1e-6];
+    let rows: Vec<Vec<f64>> = input.points().iter().map(|_| m.clone()).collect();
+    let sol = inputs.path().join("metric.sol");
+    write_sol(&sol, 3, &rows);
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("o.mesh");
+    let iso = dir.path().join("iso.mesh");
+    ok(&[
+        "refine",
+        &mesh_path,
+        "-o",
+        out.to_str().unwrap(),
+        "--size",
+        sol.to_str().unwrap(),
+    ]);
+    ok(&[
+        "refine",
+        &mesh_path,
+        "-o",
+        iso.to_str().unwrap(),
+        "--hsiz",
+        &hx.to_string(),
+    ]);
+    let extent = |m: &TetMesh, axis: usize| {
+        edges(m)
+            .iter()
+            .map(|(a, b)| (b[axis] - a[axis]).abs())
+            .fold(0.0f64, f64::max)
+    };
+    let (aniso, _) = load_mesh(&out).unwrap();
+    let (isotropic, _) = load_mesh(&iso).unwrap();
+    aniso.check().unwrap();
+    assert!(extent(&aniso, 0) <= 1.5 * hx, "x: {}", extent(&aniso, 0));
+    // Edges along y and z are not split: the block's unit edges remain.
+    assert!(extent(&aniso, 1) >= 0.99, "y: {}", extent(&aniso, 1));
+    assert!(extent(&aniso, 2) >= 0.99, "z: {}", extent(&aniso, 2));
+    // The same length as an isotropic size refines every direction.
+    for axis in 0..3 {
+        assert!(extent(&isotropic, axis) <= 1.5 * hx, "iso axis {axis}");
+    }
+    assert!(aniso.n_tets() < isotropic.n_tets());
+    assert!(aniso.n_tets() > 2 * input.n_tets());
+}
+
+#[test]
+fn hsiz_and_hmax_are_met_and_steps_can_be_counted() {
+    let inputs = tempfile::tempdir().unwrap();
+    let (mesh_path, _) = block(inputs.path());
+    let dir = tempfile::tempdir().unwrap();
+    for (opt, h) in [("--hsiz", 0.6), ("--hmax", 0.45)] {
+        let out = dir.path().join("o.mesh");
+        let o = ok(&[
+            "refine",
+            &mesh_path,
+            "-o",
+            out.to_str().unwrap(),
+            opt,
+            &h.to_string(),
+            "--steps",
+            "auto",
+        ]);
+        let (m, _) = load_mesh(&out).unwrap();
+        let longest = edges(&m)
+            .iter()
+            .map(|(a, b)| norm(sub(*b, *a)))
+            .fold(0.0f64, f64::max);
+        assert!(longest <= 1.5 * h, "{opt} {h}: longest edge {longest}");
+        assert!(!String::from_utf8_lossy(&o.stderr).contains("still longer"));
+    }
+    // One pass only: some edges are still long, and the user is told.
+    let out = dir.path().join("one.mesh");
+    let o = ok(&[
+        "refine",
+        &mesh_path,
+        "-o",
+        out.to_str().unwrap(),
+        "--hsiz",
+        "0.2",
+        "--steps",
+        "1",
+    ]);
+    assert!(String::from_utf8_lossy(&o.stderr).contains("still longer"));
+    let r = tetrefine(&["refine", &mesh_path, "-o", "x.mesh", "--steps", "auto"]);
+    assert_eq!(r.status.code(), Some(1));
+}
+
+#[test]
+fn bad_size_maps_name_the_file_and_line_and_nothing_is_written() {
+    let inputs = tempfile::tempdir().unwrap();
+    let (mesh_path, input) = block(inputs.path());
+    let n = input.n_points();
+    let good: Vec<Vec<f64>> = (0..n).map(|_| vec![0.5]).collect();
+    let metric = vec![1.0, 0.0, 1.0, 0.0, 0.0, 1.0];
+    // (file, solution type, rows, line of the bad entry, message)
+    type Case<'a> = (&'a str, u8, Vec<Vec<f64>>, usize, &'a str);
+    let cases: Vec<Case> = vec![
+        (
+            "zero.sol",
+            1,
+            {
+                let mut r = good.clone();
+                r[3][0] = 0.0;
+                r
+            },
+            11,
+            "not a positive length",
+        ),
+        (
+            "negative.sol",
+            1,
+            {
+                let mut r = good.clone();
+                r[0][0] = -1.0;
+                r
+            },
+            8,
+            "not a positive length",
+        ),
+        (
+            "nan.sol",
+            1,
+            {
+                let mut r = good.clone();
+                r[5][0] = f64::NAN;
+                r
+            },
+            13,
+            "not a finite number",
+        ),
+        (
+            "count.sol",
+            1,
+            good[1..].to_vec(),
+            6,
+            "entries but the mesh has",
+        ),
+        (
+            "indefinite.sol",
+            3,
+            {
+                let mut r: Vec<Vec<f64>> = (0..n).map(|_| metric.clone()).collect();
+                r[2] = vec![1.0, 2.0, 1.0, 0.0, 0.0, 1.0];
+                r
+            },
+            10,
+            "not positive definite",
+        ),
+    ];
+    let dir = tempfile::tempdir().unwrap();
+    for (name, ty, rows, line, what) in cases {
+        let p = inputs.path().join(name);
+        write_sol(&p, ty, &rows);
+        let o = tetrefine(&[
+            "refine",
+            &mesh_path,
+            "-o",
+            dir.path().join("o.vtu").to_str().unwrap(),
+            "--size",
+            p.to_str().unwrap(),
+        ]);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(1), "{name}: {err}");
+        let at = format!("{}:{line}:", p.display());
+        assert!(
+            err.contains(&at) && err.contains(what),
+            "{name}: {at} {what}: {err}"
+        );
+        assert!(files_in(dir.path()).is_empty());
+    }
+    let o = tetrefine(&[
+        "refine",
+        &mesh_path,
+        "-o",
+        dir.path().join("o.vtu").to_str().unwrap(),
+        "--hsiz",
+        "0",
+    ]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(files_in(dir.path()).is_empty());
+}

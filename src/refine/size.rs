@@ -1,0 +1,345 @@
+//! Size-driven refinement: split every edge longer than its target, as MMG
+//! reads a size map.
+//!
+//! A size map gives, per point, either a target edge length `h` (isotropic;
+//! MMG's scalar `SolAtVertices`) or a symmetric positive-definite metric `M`
+//! (anisotropic; MMG's 6-component tensor `m11 m12 m22 m13 m23 m33`): the
+//! length of an edge `e` in the metric is `sqrt(eᵀ M e)`, and `M = I / h²`
+//! is the isotropic case. An edge `(a, b)` is long when the mean of its
+//! lengths in the metrics of `a` and `b` exceeds [`SPLIT_ABOVE`].
+//!
+//! One [`size_pass`] splits the long edges at their midpoints
+//! ([`crate::ops::split_edge`]), longest first, the new point's metric the
+//! mean of the two ends' (a mean of positive-definite matrices is positive
+//! definite); a split that would create a tet worse than the quality floor
+//! (by default the worst tet when the pass begins; for a metric, quality is
+//! measured after mapping the tet by the metric's Cholesky factor, since an
+//! anisotropic mesh is meant to be well shaped in the metric, not in x, y,
+//! z) is refused, so quality never drops below it. The optimize phase ([`crate::improve::improve`]) runs after each pass.
+//! The √3 operations never remove an old interior edge, which is why the
+//! size loop needs these splits.
+//!
+//! The splits are applied one after the other, longest first (ties by the
+//! edge's vertex ids), so the result does not depend on the thread count.
+
+use crate::geom::tet_min_sine;
+use crate::improve::{improve, ImproveOptions};
+use crate::mesh::TetMesh;
+use crate::ops::split_edge;
+use crate::topo::{edge_key, TET_EDGES};
+use glam::{DMat3, DVec3};
+
+/// Metric length above which an edge is split. Splitting an edge of length
+/// `L > √2` leaves two of `L/2 > 0.71`, the balance MMG strikes too, and
+/// every edge of the result is at most `√2 ≈ 1.41` times its target.
+pub const SPLIT_ABOVE: f64 = std::f64::consts::SQRT_2;
+
+/// A size map over the points of a mesh.
+#[derive(Clone, Debug, PartialEq)]
+pub enum SizeMap {
+    /// A target edge length per point.
+    Iso(Vec<f64>),
+    /// A metric per point, `m11 m12 m22 m13 m23 m33` (MMG's order).
+    Aniso(Vec<[f64; 6]>),
+}
+
+impl SizeMap {
+    /// Number of points the map covers.
+    pub fn len(&self) -> usize {
+        match self {
+            SizeMap::Iso(v) => v.len(),
+            SizeMap::Aniso(v) => v.len(),
+        }
+    }
+
+    /// Whether the map covers no point.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Caps every target length at `hmax` (MMG's `-hmax`): an isotropic
+    /// size becomes `min(h, hmax)`; a metric's eigenvalues are raised to at
+    /// least `1/hmax²` (done by adding the missing part along the whole
+    /// identity when the smallest eigenvalue is too small, a cheap bound
+    /// that keeps the metric positive definite and its lengths ≥ `1/hmax`
+    /// per unit).
+    pub fn cap(&mut self, hmax: f64) {
+        match self {
+            SizeMap::Iso(v) => v.iter_mut().for_each(|h| *h = h.min(hmax)),
+            SizeMap::Aniso(v) => {
+                let floor = 1.0 / (hmax * hmax);
+                for m in v.iter_mut() {
+                    let low = min_eigenvalue(m);
+                    if low < floor {
+                        let d = floor - low;
+                        m[0] += d;
+                        m[2] += d;
+                        m[5] += d;
+                    }
+                }
+            }
+        }
+    }
+
+    /// The length of `e` in the metric of point `v`.
+    pub fn length_at(&self, v: u32, e: DVec3) -> f64 {
+        match self {
+            SizeMap::Iso(h) => e.length() / h[v as usize],
+            SizeMap::Aniso(m) => {
+                let m = matrix(&m[v as usize]);
+                e.dot(m * e).max(0.0).sqrt()
+            }
+        }
+    }
+
+    /// The metric length of the edge from `a` to `b` (at `pa`, `pb`): the
+    /// mean of its lengths in the two ends' metrics.
+    pub fn edge_length(&self, a: u32, b: u32, pa: DVec3, pb: DVec3) -> f64 {
+        let e = pb - pa;
+        0.5 * (self.length_at(a, e) + self.length_at(b, e))
+    }
+
+    /// The map `x → Lᵀx` with `LLᵀ` the mean metric of the points `vs`
+    /// (Cholesky), under which Euclidean lengths are metric lengths; `None`
+    /// for an isotropic map, whose quality is the Euclidean one (the
+    /// minimum sine is invariant under scaling). The Cholesky factor of a
+    /// positive-definite matrix has a positive diagonal, so the map keeps
+    /// orientation.
+    pub fn transform(&self, vs: &[u32]) -> Option<DMat3> {
+        let SizeMap::Aniso(m) = self else {
+            return None;
+        };
+        let k = vs.len().max(1) as f64;
+        let mean: [f64; 6] =
+            std::array::from_fn(|i| vs.iter().map(|&v| m[v as usize][i]).sum::<f64>() / k);
+        let a = matrix(&mean);
+        let l11 = a.col(0)[0].max(0.0).sqrt();
+        let l21 = a.col(0)[1] / l11;
+        let l31 = a.col(0)[2] / l11;
+        let l22 = (a.col(1)[1] - l21 * l21).max(0.0).sqrt();
+        let l32 = (a.col(1)[2] - l31 * l21) / l22;
+        let l33 = (a.col(2)[2] - l31 * l31 - l32 * l32).max(0.0).sqrt();
+        // Lᵀ, column by column (glam matrices are column-major).
+        let lt = DMat3::from_cols(
+            DVec3::new(l11, 0.0, 0.0),
+            DVec3::new(l21, l22, 0.0),
+            DVec3::new(l31, l32, l33),
+        );
+        lt.is_finite().then_some(lt)
+    }
+
+    /// Appends the size of a new point halfway between `a` and `b`.
+    fn push_mean(&mut self, a: u32, b: u32) {
+        match self {
+            SizeMap::Iso(h) => {
+                let x = 0.5 * (h[a as usize] + h[b as usize]);
+                h.push(x);
+            }
+            SizeMap::Aniso(m) => {
+                let (p, q) = (m[a as usize], m[b as usize]);
+                m.push(std::array::from_fn(|i| 0.5 * (p[i] + q[i])));
+            }
+        }
+    }
+}
+
+/// The symmetric matrix of MMG's `m11 m12 m22 m13 m23 m33`: the order of
+/// a type-3 solution in a Medit `.sol` (the lower triangle row by row).
+/// MMG's reader (`MMG5_readDoubleSol3D`) swaps the file's slots 2 and 3 into
+/// its internal order `m11 m12 m13 m22 m23 m33`, which confirms the file
+/// order.
+pub fn matrix(m: &[f64; 6]) -> DMat3 {
+    DMat3::from_cols(
+        DVec3::new(m[0], m[1], m[3]),
+        DVec3::new(m[1], m[2], m[4]),
+        DVec3::new(m[3], m[4], m[5]),
+    )
+}
+
+/// Whether MMG's `m11 m12 m22 m13 m23 m33` is positive definite
+/// (Sylvester's criterion: the three leading minors are positive).
+pub fn is_positive_definite(m: &[f64; 6]) -> bool {
+    let d1 = m[0];
+    let d2 = m[0] * m[2] - m[1] * m[1];
+    let d3 = matrix(m).determinant();
+    m.iter().all(|x| x.is_finite()) && d1 > 0.0 && d2 > 0.0 && d3 > 0.0
+}
+
+/// A lower bound of the smallest eigenvalue of a symmetric matrix
+/// (Gershgorin's discs: each eigenvalue lies within a row's radius of its
+/// diagonal entry).
+fn min_eigenvalue(m: &[f64; 6]) -> f64 {
+    let a = matrix(m);
+    (0..3)
+        .map(|i| {
+            let r: f64 = (0..3).filter(|&j| j != i).map(|j| a.col(j)[i].abs()).sum();
+            a.col(i)[i] - r
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// What one [`size_pass`] did.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct SizeReport {
+    /// Edges longer than [`SPLIT_ABOVE`] when the pass began.
+    pub long_edges: usize,
+    /// Edges split.
+    pub split: usize,
+    /// Splits refused (a new tet inverted or below the quality floor).
+    pub refused: usize,
+    /// Edges still longer than [`SPLIT_ABOVE`] after the pass.
+    pub long_after: usize,
+}
+
+/// Options of [`size_pass`].
+#[derive(Clone, Debug, Default)]
+pub struct SizeOptions {
+    /// Minimum sine of the signed dihedral angles no new tet may fall
+    /// below, measured in the metric for an anisotropic map (`None`: the
+    /// worst tet of the mesh when the pass begins, [`worst_metric_quality`]).
+    pub quality_floor: Option<f64>,
+    /// The optimize phase after the splits (`passes: 0` skips it).
+    pub improve: ImproveOptions,
+}
+
+/// The long edges of `mesh`, longest first (ties by vertex ids).
+pub fn long_edges(mesh: &TetMesh, size: &SizeMap) -> Vec<(f64, [u32; 2])> {
+    let mut edges: Vec<[u32; 2]> = mesh
+        .tet_ids()
+        .flat_map(|t| {
+            let v = mesh.tet(t);
+            TET_EDGES.map(|[i, j]| edge_key(v[i], v[j]))
+        })
+        .collect();
+    edges.sort_unstable();
+    edges.dedup();
+    let mut long: Vec<(f64, [u32; 2])> = edges
+        .into_iter()
+        .map(|[a, b]| (size.edge_length(a, b, mesh.point(a), mesh.point(b)), [a, b]))
+        .filter(|&(l, _)| l > SPLIT_ABOVE)
+        .collect();
+    long.sort_by(|x, y| y.0.total_cmp(&x.0).then(x.1.cmp(&y.1)));
+    long
+}
+
+/// The worst minimum sine over the live tets.
+pub fn worst_quality(mesh: &TetMesh) -> f64 {
+    mesh.tet_ids()
+        .map(|t| tet_min_sine(&mesh.tet_points(t)))
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// The minimum sine of the tet with corners `p` seen through `t`.
+fn quality_in(t: Option<DMat3>, p: [DVec3; 4]) -> f64 {
+    match t {
+        Some(t) => tet_min_sine(&p.map(|x| t * x)),
+        None => tet_min_sine(&p),
+    }
+}
+
+/// The worst minimum sine over the live tets in the metric of `size`
+/// (each tet through the mean metric of its corners; the Euclidean
+/// [`worst_quality`] for an isotropic map).
+pub fn worst_metric_quality(mesh: &TetMesh, size: &SizeMap) -> f64 {
+    mesh.tet_ids()
+        .map(|t| quality_in(size.transform(&mesh.tet(t)), mesh.tet_points(t)))
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// One size pass (see the module documentation). `size` covers the points
+/// of `mesh` and grows with it.
+pub fn size_pass(mesh: &mut TetMesh, size: &mut SizeMap, opts: &SizeOptions) -> SizeReport {
+    assert_eq!(size.len(), mesh.n_points(), "one size per point");
+    let floor = opts
+        .quality_floor
+        .unwrap_or_else(|| worst_metric_quality(mesh, size));
+    let long = long_edges(mesh, size);
+    let mut report = SizeReport {
+        long_edges: long.len(),
+        ..SizeReport::default()
+    };
+    let mut shell = Vec::new();
+    for (_, [a, b]) in long {
+        // An earlier split may have cut this edge already.
+        mesh.ball(a, &mut shell);
+        shell.retain(|&t| mesh.tet(t).contains(&b));
+        if shell.is_empty() {
+            continue;
+        }
+        let (pa, pb) = (mesh.point(a), mesh.point(b));
+        let mid = (pa + pb) * 0.5;
+        // The pieces' quality (in the metric of the edge), before
+        // splitting: refuse below the floor.
+        let tr = size.transform(&[a, b]);
+        let worst_new = shell
+            .iter()
+            .flat_map(|&t| {
+                let v = mesh.tet(t);
+                let p = mesh.tet_points(t);
+                let mut p1 = p;
+                let mut p2 = p;
+                for i in 0..4 {
+                    if v[i] == b {
+                        p1[i] = mid;
+                    }
+                    if v[i] == a {
+                        p2[i] = mid;
+                    }
+                }
+                [quality_in(tr, p1), quality_in(tr, p2)]
+            })
+            .fold(f64::INFINITY, f64::min);
+        if worst_new < floor {
+            report.refused += 1;
+            continue;
+        }
+        match split_edge(mesh, a, b, mid) {
+            Ok(_) => {
+                size.push_mean(a, b);
+                report.split += 1;
+            }
+            Err(_) => report.refused += 1,
+        }
+    }
+    if opts.improve.passes > 0 {
+        improve(mesh, &opts.improve);
+    }
+    debug_assert_eq!(size.len(), mesh.n_points());
+    report.long_after = long_edges(mesh, size).len();
+    report
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::generate::cube_grid;
+
+    #[test]
+    fn mmg_order_and_positive_definiteness() {
+        // diag(1, 4, 9) with m12 = 0.5: m11 m12 m22 m13 m23 m33.
+        let m = [1.0, 0.5, 4.0, 0.0, 0.0, 9.0];
+        let a = matrix(&m);
+        assert_eq!(a.col(1)[0], 0.5);
+        assert_eq!(a.col(0)[1], 0.5);
+        assert_eq!(a.col(1)[1], 4.0);
+        assert!(is_positive_definite(&m));
+        assert!(!is_positive_definite(&[1.0, 2.0, 1.0, 0.0, 0.0, 1.0]));
+        assert!(!is_positive_definite(&[1.0, 0.0, 1.0, 0.0, 0.0, -1.0]));
+    }
+
+    #[test]
+    fn a_uniform_size_is_met_and_the_mesh_stays_valid() {
+        let mut mesh = TetMesh::from_data(&cube_grid(2)).unwrap().0;
+        let floor = worst_quality(&mesh);
+        let mut size = SizeMap::Iso(vec![0.2; mesh.n_points()]);
+        for _ in 0..20 {
+            let r = size_pass(&mut mesh, &mut size, &SizeOptions::default());
+            mesh.check().unwrap();
+            if r.long_after == 0 {
+                break;
+            }
+        }
+        assert!(long_edges(&mesh, &size).is_empty());
+        assert!(worst_quality(&mesh) >= floor - 1e-12);
+    }
+}
