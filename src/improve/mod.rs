@@ -4,12 +4,15 @@
 //! The objective everywhere is the paper's quality: the minimum signed sine of
 //! the dihedral angles of a tet, and for a vertex the minimum over its ball.
 
+pub mod boundary_smooth;
 pub mod colour;
+pub mod effort;
 pub mod laplacian;
 pub mod optimize;
 pub mod passes;
 pub mod ring;
 
+pub use effort::Effort;
 pub use passes::{improve, ImproveOptions, ImproveReport};
 
 use crate::geom::{all_positive, tet_min_sine};

@@ -38,7 +38,7 @@ impl Default for OptimizeParams {
 
 /// Minimum-norm point of the convex hull of `g` (a few Gilbert iterations):
 /// a direction along which all active qualities rise, if one exists.
-fn min_norm_in_hull(g: &[DVec3]) -> DVec3 {
+pub(crate) fn min_norm_in_hull(g: &[DVec3]) -> DVec3 {
     let mut x = g[0];
     for _ in 0..32 {
         // Vertex minimising <x, g_i>.

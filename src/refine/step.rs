@@ -126,11 +126,13 @@ pub fn refine_step_with_progress(
                     report.improve = improve(
                         mesh,
                         &ImproveOptions {
-                            passes: opts.opt_passes,
-                            threshold: opts.threshold,
                             movable,
                             tet_allowed,
-                            ..Default::default()
+                            ..opts.effort.improve_options(
+                                opts.opt_passes,
+                                opts.threshold,
+                                opts.hausd,
+                            )
                         },
                     );
                 }
