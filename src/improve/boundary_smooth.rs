@@ -76,6 +76,13 @@ impl Default for BoundarySmoothOptions {
     }
 }
 
+/// A [`BoundarySmoothOptions::crease_angle`] that lets only vertices of
+/// flat stars move. Coplanar input faces have normals equal up to the
+/// rounding of a normalized cross product (some 1e-15 in the cosine);
+/// 1e-4° is 1.5e-12 in the cosine, well above that and far below any real
+/// crease.
+pub const FLAT_ONLY: f64 = 1e-4;
+
 /// A decided move: vertex, position, ball, the ball's new qualities.
 type Decided = (u32, DVec3, Vec<u32>, Vec<f64>);
 
