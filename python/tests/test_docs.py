@@ -30,6 +30,16 @@ FILE_FLAGS = {
     # The memory guard is the CLI's (it estimates a process's peak from
     # /proc/meminfo); the package has none yet.
     "--max-memory": None,
+    # Field transfer and size maps (issue 17) are the CLI's only so far:
+    # the package has no point/cell fields on Mesh and no size-map argument
+    # yet. Listed here so that a new CLI flag still fails this test.
+    "--transfer": None,
+    "--no-transfer": None,
+    "--fields": None,
+    "--size": None,
+    "--size-array": None,
+    "--hsiz": None,
+    "--hmax": None,
 }
 
 

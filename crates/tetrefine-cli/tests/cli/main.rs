@@ -21,7 +21,8 @@ mod strict;
 mod surface;
 mod transfer;
 
-use std::process::Command;
+use std::path::Path;
+use std::process::{Command, Output};
 
 /// The `tetrefine` binary, run from the repository root so that the tests'
 /// relative paths (`meshes/…`) name the repository's files.
@@ -29,4 +30,30 @@ pub fn tetrefine_command() -> Command {
     let mut c = Command::new(env!("CARGO_BIN_EXE_tetrefine"));
     c.current_dir(support::root());
     c
+}
+
+/// Runs `tetrefine ARGS` from the repository root.
+pub fn run(args: &[&str]) -> Output {
+    tetrefine_command().args(args).output().unwrap()
+}
+
+/// [`run`], asserting success (the message carries stderr).
+pub fn run_ok(args: &[&str]) -> Output {
+    let o = run(args);
+    assert!(
+        o.status.success(),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    o
+}
+
+/// The names of the files in `dir`, sorted: what a command left behind.
+pub fn files_in(dir: &Path) -> Vec<String> {
+    let mut v: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    v.sort();
+    v
 }

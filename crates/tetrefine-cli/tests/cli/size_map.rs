@@ -8,28 +8,7 @@
 use std::path::Path;
 use tetrefine::{load_mesh, write_mesh, MeshStats, TetMesh};
 
-fn tetrefine(args: &[&str]) -> std::process::Output {
-    crate::tetrefine_command().args(args).output().unwrap()
-}
-
-fn ok(args: &[&str]) -> std::process::Output {
-    let o = tetrefine(args);
-    assert!(
-        o.status.success(),
-        "{args:?}: {}",
-        String::from_utf8_lossy(&o.stderr)
-    );
-    o
-}
-
-fn files_in(dir: &Path) -> Vec<String> {
-    let mut v: Vec<String> = std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .collect();
-    v.sort();
-    v
-}
+use crate::{files_in, run as tetrefine, run_ok as ok};
 
 /// A 4×4×4 block of unit cubes, six tets each, written as `.mesh`.
 fn block(dir: &Path) -> (String, TetMesh) {

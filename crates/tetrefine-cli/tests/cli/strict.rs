@@ -18,17 +18,10 @@ fn tetrefine(args: &[&str]) -> Output {
         .expect("run tetrefine")
 }
 
+use crate::files_in;
+
 fn stderr(o: &Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()
-}
-
-fn files_in(dir: &Path) -> Vec<String> {
-    let mut v: Vec<String> = std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .collect();
-    v.sort();
-    v
 }
 
 /// The byte range of the raw appended data of a `.vtu` (after `_`, before

@@ -16,28 +16,7 @@ fn v(p: [f64; 3]) -> [f64; 3] {
     [p[0] - p[1], 3.0 * p[2], -1.0 + p[0]]
 }
 
-fn tetrefine(args: &[&str]) -> std::process::Output {
-    crate::tetrefine_command().args(args).output().unwrap()
-}
-
-fn ok(args: &[&str]) -> std::process::Output {
-    let o = tetrefine(args);
-    assert!(
-        o.status.success(),
-        "{args:?}: {}",
-        String::from_utf8_lossy(&o.stderr)
-    );
-    o
-}
-
-fn files_in(dir: &Path) -> Vec<String> {
-    let mut v: Vec<String> = std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .collect();
-    v.sort();
-    v
-}
+use crate::{files_in, run as tetrefine, run_ok as ok};
 
 /// The tripod's points, as its file lists them.
 fn tripod_points() -> Vec<[f64; 3]> {
