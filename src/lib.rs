@@ -62,7 +62,7 @@ pub use improve::{improve, ImproveOptions, ImproveReport};
 pub use io::{load_mesh, read_mesh, write_mesh};
 pub use mesh::generate::cube_grid;
 pub use mesh::{
-    ball_stays_positive, BuildReport, CheckError, MeshData, MeshError, Remap, TetMesh, Where,
+    ball_stays_positive, BuildReport, CheckError, MeshData, MeshError, Remap, TetMesh, Where, DEAD,
     NO_ADJ,
 };
 pub use ops::{split_edge, OpError};

@@ -152,7 +152,7 @@ impl Tracker {
 /// The edge search and vertex smoothing run in parallel: edges are searched
 /// on the mesh as it stands and removed in order (see `EdgeRemoval::pass`),
 /// vertices are smoothed by colour classes, independent sets smoothed in
-/// parallel (see [`super::colour`]). The result does not depend on the
+/// parallel (in colour classes). The result does not depend on the
 /// number of threads.
 pub fn improve(mesh: &mut TetMesh, opts: &ImproveOptions) -> ImproveReport {
     let fixed = mesh.fixed_vertices();

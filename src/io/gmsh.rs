@@ -1335,7 +1335,7 @@ fn read_elements_v41(
     end_section(c, "$EndElements")
 }
 
-/// The MSH variant [`write_with`] writes.
+/// The MSH variant a Gmsh writer writes ([`crate::io::WriteOptions`]).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum MshFormat {
     /// MSH 2.2 ASCII: an element in several physical groups is written once

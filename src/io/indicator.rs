@@ -115,7 +115,7 @@ impl fmt::Display for IndicatorSource {
     }
 }
 
-/// Reads the indicator `spec` (see the [module docs](self) for the formats)
+/// Reads the indicator `spec` (plain text, CSV `tet,value`, Medit `.sol` or `FILE.vtu:ARRAY`; the README lists them)
 /// for `mesh`: one value per live tet, in [`TetMesh::tet_ids`] order, each
 /// finite and ≥ 0.
 pub fn read_indicator(spec: &str, mesh: &TetMesh) -> Result<Vec<f64>, IoError> {

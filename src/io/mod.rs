@@ -45,9 +45,9 @@ pub use vtk::{
 };
 
 pub(crate) use crate::file::open_message;
-/// The file helpers (errors, whole-file reads, atomic writes and output
-/// sets) live below every area, in [`crate::file`], so that report and the
-/// surface schemes share them without going through `io`.
+// The file helpers (errors, whole-file reads, atomic writes and output
+// sets) live below every area, in `crate::file`, so that report and the
+// surface schemes share them without going through `io`.
 pub use crate::file::{
     install_signal_cleanup, remove_stale_temporaries, temporary_path, write_atomic, IoError,
     IoErrorKind, OutputSet, TEMP_MARKER,

@@ -49,7 +49,7 @@ use std::fmt;
 use std::str::FromStr;
 
 /// A rule that selects tets for refinement. Parse one with [`str::parse`]
-/// (see the [module docs](self) for the syntax) and apply it with [`select`].
+/// (`fraction:F`, `doerfler:θ`, `max:γ`, `threshold:X`, `region:ID,…`, `box:x0,y0,z0,x1,y1,z1`, `sphere:x,y,z,r`) and apply it with [`select`].
 #[derive(Clone, Debug, PartialEq)]
 pub enum MarkStrategy {
     /// `fraction:F`: the ⌈F·n⌉ tets with the largest values, 0 < F ≤ 1.
@@ -257,7 +257,7 @@ fn split_union(s: &str) -> Vec<&str> {
 impl FromStr for MarkStrategy {
     type Err = String;
 
-    /// Parses a strategy (see the [module docs](self)); `A+B` is a union.
+    /// Parses a strategy (the syntax of [`MarkStrategy`]); `A+B` is a union.
     fn from_str(s: &str) -> Result<MarkStrategy, String> {
         let parts = split_union(s)
             .into_iter()

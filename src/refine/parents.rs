@@ -15,7 +15,7 @@ use rayon::prelude::*;
 /// domain. Overwrites `parent`.
 ///
 /// The walks are independent: they run in parallel over runs of
-/// [`PARENT_BATCH`] tet slots, each run's answers gathered before they are
+/// `PARENT_BATCH` tet slots, each run's answers gathered before they are
 /// written, so the extra memory stays at 4 bytes per slot of one run.
 pub fn locate_parents(input: &TetMesh, mesh: &mut TetMesh) {
     let Some(first) = input.tet_ids().next() else {
@@ -84,7 +84,7 @@ pub fn contains(mesh: &TetMesh, t: u32, x: DVec3) -> bool {
 /// Visibility walk from `start` towards `x`; returns the tet containing `x`.
 /// In a non-convex domain the straight walk can reach the boundary first;
 /// then a breadth-first search over face neighbours from `start` (at most
-/// [`WALK_SEARCH_LIMIT`] tets) looks for the containing tet. If none is found (the point
+/// `WALK_SEARCH_LIMIT` tets) looks for the containing tet. If none is found (the point
 /// is outside the domain), the tet where the walk left the domain.
 pub fn walk_to(mesh: &TetMesh, start: u32, x: DVec3) -> u32 {
     let end = straight_walk(mesh, start, x);

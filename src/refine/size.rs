@@ -196,7 +196,7 @@ pub struct SizeReport {
 pub struct SizeOptions {
     /// Minimum sine of the signed dihedral angles no new tet may fall
     /// below, measured in the metric for an anisotropic map (`None`: the
-    /// worst tet of the mesh when the pass begins, [`worst_metric_quality`]).
+    /// worst tet of the mesh when the pass begins, measured in the metric).
     pub quality_floor: Option<f64>,
     /// The optimize phase after the splits (`passes: 0` skips it).
     pub improve: ImproveOptions,

@@ -158,7 +158,7 @@ pub fn to_svg(h: &Histogram, title: &str) -> Result<String, String> {
     Ok(svg)
 }
 
-/// The histogram drawn as a PNG image (RGB, [`PLOT_WIDTH`] × [`PLOT_HEIGHT`]),
+/// The histogram drawn as a PNG image (RGB, `PLOT_WIDTH` × `PLOT_HEIGHT`),
 /// with labelled axes and `title`; returns the encoded file bytes.
 pub fn to_png(h: &Histogram, title: &str) -> Result<Vec<u8>, String> {
     register_font();

@@ -158,7 +158,7 @@ enum VertexKind {
 }
 
 /// Half-edge adjacency of a triangle list: half-edge 3t+i runs from
-/// tris[t][i] to tris[t][(i+1)%3]; curve half-edges have no twin here.
+/// `tris[t][i]` to `tris[t][(i+1)%3]`; curve half-edges have no twin here.
 pub struct TriTopology {
     twin: Vec<u32>,
     curve: Vec<bool>,

@@ -1,5 +1,5 @@
 //! Local tables of a tetrahedron, their inverses, the one edge and face key,
-//! and the parallel scatter helpers ([`scatter`]) that hold all of the core's
+//! and the parallel scatter helpers (`scatter`) that hold all of the core's
 //! `unsafe`.
 //!
 //! Local numbering: vertices `0..4`; face `f` is the triangle without vertex

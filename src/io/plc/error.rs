@@ -1,7 +1,7 @@
 //! [`PlcError`]: why a PLC cannot be meshed.
 
 /// Why a PLC cannot be meshed. Point, facet, polygon, hole and region numbers
-/// are 1-based, in the order of the [`Plc`]'s lists.
+/// are 1-based, in the order of the [`crate::io::Plc`]'s lists.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum PlcError {
     /// No facet at all.

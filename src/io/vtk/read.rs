@@ -38,7 +38,7 @@ fn cell_size(ty: i64) -> Option<Option<i64>> {
     })
 }
 
-/// [`read`], and a note on what was dropped (cells other than tetrahedra
+/// the reader, and a note on what was dropped (cells other than tetrahedra
 /// and triangles, by VTK type), if anything was.
 pub fn read_noted(path: &Path) -> Result<(MeshData, Option<String>), IoError> {
     with_pieces(path, |layout, elems, pieces| {
@@ -234,7 +234,7 @@ fn with_pieces<R>(
 #[derive(Clone, Debug, PartialEq)]
 pub struct TetCellArray {
     /// One value per tetrahedron (VTK cell type 10), in file order over all
-    /// pieces: the order in which [`read`] lists the tets. Integer arrays are
+    /// pieces: the order in which the reader lists the tets. Integer arrays are
     /// converted to `f64`.
     pub values: Vec<f64>,
     /// Per value, the 1-based file line of the `<DataArray>` element that
@@ -243,7 +243,7 @@ pub struct TetCellArray {
 }
 
 /// Reads the one-component cell array `name` of a `.vtu` file, keeping the
-/// values of the tetrahedra only (the cells [`read`] keeps, in the same
+/// values of the tetrahedra only (the cells the reader keeps, in the same
 /// order), so that value `i` belongs to tet `i` of the mesh read from the
 /// same file. Every piece must carry the array. The values are not checked
 /// (NaN and infinities pass through).
@@ -649,7 +649,7 @@ pub const DERIVED_CELL_ARRAYS: [&str; 12] = [
 
 /// [`read_noted`] with the point and cell arrays of the file as fields
 /// ([`MeshMeta::point_fields`](crate::io::meta::MeshMeta),
-/// `cell_fields`; cell arrays at the tetrahedra only, in the order [`read`]
+/// `cell_fields`; cell arrays at the tetrahedra only, in the order the reader
 /// lists them), except the arrays tetrefine derives ([`DERIVED_POINT_ARRAYS`],
 /// [`DERIVED_CELL_ARRAYS`]). With several pieces, an array must be in every
 /// piece with the same number of components. Every value must be finite: a

@@ -29,34 +29,35 @@ pub fn say_text(text: &str) {
     }
 }
 
-/// Records an error when standard output was closed when the process
-/// started (`>&-`). Rust's runtime then opens `/dev/null` read-write on
-/// descriptor 1 before `main`, so every write "succeeds" and the output is
-/// lost without a word; a shell's `> /dev/null` opens it write-only, so
-/// `/dev/null` read-write on descriptor 1 is taken for a closed one (only
-/// `1<>/dev/null` looks the same, and discards the output just as well).
-fn refuse_closed_stdout() {
-    static CLOSED: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
-    let closed = *CLOSED.get_or_init(|| {
-        // SAFETY: fcntl and fstat/stat on a descriptor and a fixed path,
-        // with zeroed out-structures of the right type.
-        unsafe {
-            let flags = libc::fcntl(1, libc::F_GETFL);
-            if flags < 0 {
-                return true;
-            }
-            if flags & libc::O_ACCMODE != libc::O_RDWR {
-                return false;
-            }
-            let (mut fd, mut null): (libc::stat, libc::stat) =
-                (std::mem::zeroed(), std::mem::zeroed());
-            libc::fstat(1, &mut fd) == 0
-                && libc::stat(c"/dev/null".as_ptr(), &mut null) == 0
-                && (fd.st_mode & libc::S_IFMT) == libc::S_IFCHR
-                && fd.st_rdev == null.st_rdev
+/// Whether descriptor 1 was closed when the process started (`>&-`),
+/// read by [`PROBE_STDOUT`] before Rust's runtime looks at it: `main`'s
+/// prologue reopens a closed descriptor 0–2 on `/dev/null`, after which
+/// every write "succeeds" and the output is lost without a word. Asking
+/// afterwards cannot tell that from a caller's own `/dev/null` (Python's
+/// `subprocess.DEVNULL` opens it read-write too), so the question is put
+/// before `main`.
+static STDOUT_CLOSED_AT_START: std::sync::atomic::AtomicBool =
+    std::sync::atomic::AtomicBool::new(false);
+
+/// Run by the dynamic loader with the other `.init_array` constructors,
+/// before the C `main` that starts Rust's runtime.
+#[cfg(target_os = "linux")]
+#[used]
+#[link_section = ".init_array"]
+static PROBE_STDOUT: extern "C" fn() = {
+    extern "C" fn probe() {
+        // SAFETY: fcntl(F_GETFD) on a descriptor number only reads its
+        // flags; it fails with EBADF when the descriptor is not open.
+        if unsafe { libc::fcntl(1, libc::F_GETFD) } == -1 {
+            STDOUT_CLOSED_AT_START.store(true, std::sync::atomic::Ordering::Relaxed);
         }
-    });
-    if closed {
+    }
+    probe
+};
+
+/// Records an error if standard output was closed when the process started.
+fn refuse_closed_stdout() {
+    if STDOUT_CLOSED_AT_START.load(std::sync::atomic::Ordering::Relaxed) {
         record(std::io::Error::new(
             std::io::ErrorKind::BrokenPipe,
             "it was closed when the command started",

@@ -350,6 +350,21 @@ fn a_failed_write_to_standard_output_fails_the_command() {
         .output()
         .unwrap();
     assert!(o.status.success(), "{}", stderr(&o));
+    // So is `/dev/null` opened read-write, as Python's subprocess.DEVNULL
+    // does: after Rust's runtime reopens a closed descriptor it looks the
+    // same, which is why the closed one is detected before `main`.
+    let o = Command::new("sh")
+        .arg("-c")
+        .arg(format!(
+            "'{}' quality '{}' --json -o '{}' 1<>/dev/null",
+            env!("CARGO_BIN_EXE_tetrefine"),
+            tripod.display(),
+            out.display()
+        ))
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(out.exists(), "the output is written");
 }
 
 #[test]
