@@ -65,6 +65,66 @@ fn h(p: [f64; 3]) -> f64 {
     0.35 + 0.15 * p[0]
 }
 
+/// Every edge at most 1.5 times its target [`h`], in the mean of the two
+/// ends' inverse sizes (the length of the edge measured in the size map).
+fn assert_edges_meet_h(m: &TetMesh) {
+    let mut worst = 0.0f64;
+    for (a, b) in edges(m) {
+        let l = norm(sub(b, a)) * 0.5 * (1.0 / h(a) + 1.0 / h(b));
+        worst = worst.max(l);
+    }
+    assert!(worst <= 1.5, "an edge is {worst:.3} times its target");
+}
+
+#[test]
+fn a_size_given_as_a_vtu_point_array_is_met() {
+    let inputs = tempfile::tempdir().unwrap();
+    let (_, input) = block(inputs.path());
+    let sizes: Vec<f64> = input.points().iter().map(|p| h(p.to_array())).collect();
+    let vtu = inputs.path().join("block.vtu");
+    tetrefine::io::write_vtu_with(
+        &vtu,
+        &input,
+        None,
+        &[],
+        &[tetrefine::io::PointArray::Float64("h".into(), 1, sizes)],
+    )
+    .unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("o.mesh");
+    let o = tetrefine(&[
+        "refine",
+        vtu.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--size-array",
+        "h",
+        "--no-transfer",
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let (m, _) = load_mesh(&out).unwrap();
+    m.check().unwrap();
+    assert!(
+        m.n_tets() > input.n_tets(),
+        "the size map asks for smaller tets"
+    );
+    assert_edges_meet_h(&m);
+    // A name the file does not hold is an error naming it, and nothing is
+    // written.
+    let missing = dir.path().join("missing.mesh");
+    let o = tetrefine(&[
+        "refine",
+        vtu.to_str().unwrap(),
+        "-o",
+        missing.to_str().unwrap(),
+        "--size-array",
+        "nope",
+    ]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("nope"));
+    assert!(!missing.exists());
+}
+
 #[test]
 fn a_scalar_size_map_is_met_with_about_the_predicted_count_and_no_quality_loss() {
     let inputs = tempfile::tempdir().unwrap();
@@ -88,14 +148,7 @@ fn a_scalar_size_map_is_met_with_about_the_predicted_count_and_no_quality_loss()
     ]);
     let (m, _) = load_mesh(&out).unwrap();
     m.check().unwrap();
-    // Every edge at most 1.5 times its target, in the mean of the two
-    // ends' sizes (the size is linear: this is the size at the midpoint).
-    let mut worst = 0.0f64;
-    for (a, b) in edges(&m) {
-        let l = norm(sub(b, a)) * 0.5 * (1.0 / h(a) + 1.0 / h(b));
-        worst = worst.max(l);
-    }
-    assert!(worst <= 1.5, "an edge is {worst:.3} times its target");
+    assert_edges_meet_h(&m);
     // The prediction: ∫ dV / (h³ / (6√2)) over the block, h depending on x
     // only: 16 · 6√2 · ∫₀⁴ dx / h(x)³.
     let n = 100_000;
