@@ -19,7 +19,7 @@ fn sample_values(n: usize, seed: u64) -> Vec<f64> {
         .map(|i| match i % 7 {
             0 => 0.0,
             1 => 0.5,
-            _ => rng.unit().powi(3) * 10f64.powi(rng.below(9) as i32 - 4),
+            _ => rng.next_f64().powi(3) * 10f64.powi(rng.below(9) as i32 - 4),
         })
         .collect()
 }

@@ -30,15 +30,9 @@ fn perturbed_cube() -> TetMesh {
     let (mut mesh, _) = TetMesh::from_data(&cube_grid(n)).unwrap();
     let fixed = mesh.fixed_vertices();
     let h = 1.0 / n as f64;
-    let mut state = 0x2545_f491_4f6c_dd1du64;
-    let mut next = || {
-        // xorshift64*: a deterministic sequence in [-1, 1).
-        state ^= state >> 12;
-        state ^= state << 25;
-        state ^= state >> 27;
-        let r = state.wrapping_mul(0x2545_f491_4f6c_dd1d);
-        (r >> 11) as f64 / (1u64 << 52) as f64 - 1.0
-    };
+    let mut rng = tetrefine::SplitMix64(0x2545_f491_4f6c_dd1d);
+    // A deterministic sequence in [-1, 1).
+    let mut next = || 2.0 * rng.next_f64() - 1.0;
     let mut ball = Vec::new();
     for v in 0..mesh.n_points() as u32 {
         let d = glam::DVec3::new(next(), next(), next()) * (0.35 * h);

@@ -207,7 +207,7 @@ fn max_and_threshold_follow_their_inequalities() {
     let n = mesh.n_tets();
     let mut rng = Rng(77);
     for _ in 0..50 {
-        let values: Vec<f64> = (0..n).map(|_| rng.unit() * 10.0).collect();
+        let values: Vec<f64> = (0..n).map(|_| rng.next_f64() * 10.0).collect();
         let vmax = values.iter().cloned().fold(0.0, f64::max);
         for g in [0.0, 0.3, 0.5, 0.8, 1.0] {
             let sel = select(&MarkStrategy::Max(g), Some(&values), &mesh).unwrap();
@@ -306,7 +306,7 @@ fn union_is_the_or_of_its_parts() {
     let (_, mesh) = kuhn_mesh(3, 2, 2);
     let n = mesh.n_tets();
     let mut rng = Rng(99);
-    let values: Vec<f64> = (0..n).map(|_| rng.unit()).collect();
+    let values: Vec<f64> = (0..n).map(|_| rng.next_f64()).collect();
     let parts = [
         "fraction:0.1",
         "region:3",

@@ -65,25 +65,5 @@ pub fn centroid(d: &MeshData, t: usize) -> [f64; 3] {
     c.map(|x| x / 4.0)
 }
 
-/// xorshift64: a fixed, reproducible sequence.
-pub struct Rng(pub u64);
-
-impl Rng {
-    /// The next 64 random bits.
-    pub fn next(&mut self) -> u64 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 7;
-        self.0 ^= self.0 << 17;
-        self.0
-    }
-
-    /// A number in `0..n`.
-    pub fn below(&mut self, n: u64) -> u64 {
-        self.next() % n
-    }
-
-    /// A float in `[0, 1)`.
-    pub fn unit(&mut self) -> f64 {
-        (self.next() >> 11) as f64 / (1u64 << 53) as f64
-    }
-}
+/// The tests' seeded generator: the crate's own (one RNG in the workspace).
+pub use tetrefine::SplitMix64 as Rng;
