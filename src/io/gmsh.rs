@@ -437,6 +437,22 @@ struct Collector {
     views: Vec<NodeView>,
 }
 
+/// The index of an earlier element with the vertex set `key` (sorted), or
+/// `None` after noting this one, the `next` element, under that key.
+fn seen_before<K: std::hash::Hash + Eq>(
+    seen: &mut HashMap<K, u32>,
+    key: K,
+    next: usize,
+) -> Option<usize> {
+    match seen.entry(key) {
+        std::collections::hash_map::Entry::Occupied(e) => Some(*e.get() as usize),
+        std::collections::hash_map::Entry::Vacant(e) => {
+            e.insert(next as u32);
+            None
+        }
+    }
+}
+
 impl Collector {
     fn new(merge: bool) -> Collector {
         Collector {
@@ -530,16 +546,12 @@ impl Collector {
         match role {
             Role::Tet => {
                 let v = [n[0], n[1], n[2], n[3]];
-                if self.merge {
-                    let i = self.data.tets.len() as u32;
-                    if let Some(&j) = self.seen_tets.get(&sorted(v)) {
-                        if let Some(m) = self.merged(self.tet_tags[j as usize], tag) {
-                            self.tet_tags[j as usize] = m;
-                            return;
-                        }
-                    } else {
-                        self.seen_tets.insert(sorted(v), i);
-                    }
+                let seen = self
+                    .merge
+                    .then(|| seen_before(&mut self.seen_tets, sorted(v), self.data.tets.len()))
+                    .flatten();
+                if self.absorb(role, seen, tag) {
+                    return;
                 }
                 self.data.tets.push(v);
                 self.tet_tags.push(tag);
@@ -549,52 +561,70 @@ impl Collector {
             }
             Role::Triangle => {
                 let v = [n[0], n[1], n[2]];
-                if self.merge {
-                    let i = self.data.triangles.len() as u32;
-                    if let Some(&j) = self.seen_tris.get(&sorted(v)) {
-                        if let Some(m) = self.merged(self.tri_tags[j as usize], tag) {
-                            self.tri_tags[j as usize] = m;
-                            return;
-                        }
-                    } else {
-                        self.seen_tris.insert(sorted(v), i);
-                    }
+                let seen = self
+                    .merge
+                    .then(|| seen_before(&mut self.seen_tris, sorted(v), self.data.triangles.len()))
+                    .flatten();
+                if self.absorb(role, seen, tag) {
+                    return;
                 }
                 self.data.triangles.push((v, 0));
                 self.tri_tags.push(tag);
             }
             Role::Edge => {
                 let v = [n[0], n[1]];
-                if self.merge {
-                    let i = self.data.edges.len() as u32;
-                    if let Some(&j) = self.seen_edges.get(&sorted(v)) {
-                        if let Some(m) = self.merged(self.edge_tags[j as usize], tag) {
-                            self.edge_tags[j as usize] = m;
-                            return;
-                        }
-                    } else {
-                        self.seen_edges.insert(sorted(v), i);
-                    }
+                let seen = self
+                    .merge
+                    .then(|| seen_before(&mut self.seen_edges, sorted(v), self.data.edges.len()))
+                    .flatten();
+                if self.absorb(role, seen, tag) {
+                    return;
                 }
                 self.data.edges.push((v, 0));
                 self.edge_tags.push(tag);
             }
             Role::Corner => {
-                if self.merge {
-                    let i = self.data.corners.len() as u32;
-                    if let Some(&j) = self.seen_corners.get(&n[0]) {
-                        if let Some(m) = self.merged(self.corner_tags[j as usize], tag) {
-                            self.corner_tags[j as usize] = m;
-                            return;
-                        }
-                    } else {
-                        self.seen_corners.insert(n[0], i);
-                    }
+                let seen = self
+                    .merge
+                    .then(|| seen_before(&mut self.seen_corners, n[0], self.data.corners.len()))
+                    .flatten();
+                if self.absorb(role, seen, tag) {
+                    return;
                 }
                 self.data.corners.push(n[0]);
                 self.corner_tags.push(tag);
             }
             Role::Skip => {}
+        }
+    }
+
+    /// MSH 2.2's merge of an element listed again: element `seen` (of
+    /// `role`, found by [`seen_before`]) takes the copy's physical tags.
+    /// `false` when there is no earlier element, or when the copy brings no
+    /// new tag — a true duplicate, which is then added so that building the
+    /// mesh reports it.
+    fn absorb(&mut self, role: Role, seen: Option<usize>, tag: ElemTag) -> bool {
+        let Some(j) = seen else {
+            return false;
+        };
+        let old = self.tags_mut(role)[j];
+        match self.merged(old, tag) {
+            Some(m) => {
+                self.tags_mut(role)[j] = m;
+                true
+            }
+            None => false,
+        }
+    }
+
+    /// The tag list of the elements of `role`.
+    fn tags_mut(&mut self, role: Role) -> &mut Vec<ElemTag> {
+        match role {
+            Role::Tet => &mut self.tet_tags,
+            Role::Triangle => &mut self.tri_tags,
+            Role::Edge => &mut self.edge_tags,
+            Role::Corner => &mut self.corner_tags,
+            Role::Skip => unreachable!("skipped elements are never stored"),
         }
     }
 
