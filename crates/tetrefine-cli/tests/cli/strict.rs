@@ -20,6 +20,17 @@ fn tetrefine(args: &[&str]) -> Output {
 
 use crate::files_in;
 
+/// The unit tetrahedron's surface as `tet.obj` in `dir`, faces outward.
+fn unit_tet_obj(dir: &Path) -> PathBuf {
+    let tet = dir.join("tet.obj");
+    std::fs::write(
+        &tet,
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 2 3 4\nf 1 4 3\n",
+    )
+    .unwrap();
+    tet
+}
+
 fn stderr(o: &Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()
 }
@@ -729,12 +740,7 @@ fn a_non_manifold_boundary_is_accepted_with_a_note_naming_it() {
 #[test]
 fn a_neck_or_cut_so_small_that_points_coincide_is_refused() {
     let dir = tempfile::tempdir().unwrap();
-    let tet = dir.path().join("tet.obj");
-    std::fs::write(
-        &tet,
-        "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 2 3 4\nf 1 4 3\n",
-    )
-    .unwrap();
+    let tet = unit_tet_obj(dir.path());
     let cube = dir.path().join("cube.obj");
     std::fs::write(
         &cube,
@@ -990,12 +996,7 @@ fn the_memory_guard_checks_each_step_and_bisect_and_improve() {
 #[test]
 fn surface_steps_are_held_against_the_memory_budget() {
     let dir = tempfile::tempdir().unwrap();
-    let tet = dir.path().join("tet.obj");
-    std::fs::write(
-        &tet,
-        "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 2 3 4\nf 1 4 3\n",
-    )
-    .unwrap();
+    let tet = unit_tet_obj(dir.path());
     let out = dir.path().join("o.obj");
     let run = |steps: &str, mem: &str| {
         tetrefine(&[
