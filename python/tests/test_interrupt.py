@@ -19,6 +19,18 @@ from conftest import TRIPOD, cube_grid
 HERE = Path(__file__).resolve().parent
 
 
+@pytest.fixture(autouse=True)
+def python_handles_sigint():
+    # A process started in the background by a non-interactive shell (`cmd &`)
+    # inherits SIGINT ignored, and Python then installs no handler of its own:
+    # Ctrl-C and `_thread.interrupt_main()` do nothing there. The tests are
+    # about what happens when Python handles SIGINT, as in a terminal, so
+    # they say so.
+    old = signal.signal(signal.SIGINT, signal.default_int_handler)
+    yield
+    signal.signal(signal.SIGINT, old)
+
+
 @pytest.fixture(scope="module")
 def cube():
     points, tets = cube_grid(16)  # 24,576 tets; steps=2 gives about 0.9M
