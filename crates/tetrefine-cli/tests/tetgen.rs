@@ -595,7 +595,17 @@ fn outside_seeds_and_hostile_switches_are_refused_cleanly() {
         "{}",
         String::from_utf8_lossy(&o.stderr)
     );
-    assert!(String::from_utf8_lossy(&o.stderr).contains("outside the surface"));
+    // The error names the file and the seed's line: 8 points after the
+    // header, 6 facets of two lines, the hole count, the region count.
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.starts_with(&format!(
+            "error: {}: region 1 (line {}) has its seed at",
+            poly.display(),
+            1 + 8 + 1 + 12 + 1 + 1 + 1
+        )) && err.contains("outside the surface"),
+        "{err}"
+    );
     assert!(o.stdout.is_empty() && !out.exists());
     let long = "p".repeat(1024);
     assert!(

@@ -593,8 +593,7 @@ fn cube() -> Plc {
                 marker: i as i32,
             })
             .collect(),
-        holes: Vec::new(),
-        regions: Vec::new(),
+        ..Default::default()
     }
 }
 
@@ -636,7 +635,11 @@ fn region_seeds_outside_the_domain_or_in_a_hole_are_refused() {
     assert!(
         matches!(
             c.validate(),
-            Err(PlcError::SeedInHole { index: 1, hole: 1 })
+            Err(PlcError::SeedInHole {
+                index: 1,
+                hole: 1,
+                ..
+            })
         ),
         "{:?}",
         c.validate()
