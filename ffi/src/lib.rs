@@ -646,6 +646,30 @@ mod tests {
     }
 
     #[test]
+    fn a_caller_holding_the_lock_meshes_with_tetrahedralize_locked() {
+        let (p, fp, pv, v, m) = cube();
+        let input = Input {
+            points: &p,
+            facet_polygon_counts: &fp,
+            polygon_vertex_counts: &pv,
+            polygon_vertices: &v,
+            facet_markers: Some(&m),
+            ..Default::default()
+        };
+        let lock = lock();
+        let out = tetrahedralize_locked(&lock, "pQ", &input).unwrap();
+        drop(lock);
+        let vol: f64 = out
+            .tets
+            .chunks_exact(4)
+            .map(|t| tet_volume(&out.points, t).abs())
+            .sum();
+        assert!((vol - 1.0).abs() < 1e-12, "volume {vol}");
+        // The lock is free again: the locking entry point works.
+        assert_eq!(tetrahedralize("pQ", &input).unwrap(), out);
+    }
+
+    #[test]
     fn bad_arrays_are_rejected_before_tetgen() {
         let (p, fp, pv, mut v, m) = cube();
         v[3] = 8;
