@@ -18,9 +18,7 @@ use std::sync::{Arc, Mutex, OnceLock};
 
 use numpy::ndarray::ArrayView2;
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyArrayMethods};
-use pyo3::exceptions::{
-    PyFileNotFoundError, PyOSError, PyRuntimeError, PyTimeoutError, PyValueError,
-};
+use pyo3::exceptions::{PyFileNotFoundError, PyOSError, PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
@@ -899,7 +897,7 @@ fn mesh_surface(
         Ok(mesh) => Ok(Mesh::new_plain(mesh, BuildNotes::default())),
         Err(core_api::MeshError::File(m)) => Err(PyOSError::new_err(m)),
         Err(core_api::MeshError::Value(m)) => Err(PyValueError::new_err(m)),
-        Err(core_api::MeshError::Timeout(m)) => Err(PyTimeoutError::new_err(m)),
+        Err(core_api::MeshError::Timeout(m)) => Err(pyo3::exceptions::PyTimeoutError::new_err(m)),
         Err(core_api::MeshError::Crash(m)) => Err(PyRuntimeError::new_err(m)),
     }
 }
