@@ -26,7 +26,7 @@
 
 use std::ffi::CString;
 use std::fmt;
-use std::sync::Mutex;
+use std::sync::{Mutex, MutexGuard};
 
 /// The shim's C interface (see `src/shim.cpp`).
 pub mod raw {
@@ -242,6 +242,22 @@ impl Output {
 /// Serialises every call into TetGen (its predicates keep global state).
 static TETGEN: Mutex<()> = Mutex::new(());
 
+/// The right to call TetGen: the global lock that serialises every call,
+/// held until this value is dropped (see [`lock`] and [`tetrahedralize_locked`]).
+///
+/// A caller that forks a process to run TetGen in takes it around `fork`, so
+/// that no other thread is inside TetGen (or holds the lock) at that moment:
+/// the child then inherits TetGen's global state at rest and a lock it owns.
+#[derive(Debug)]
+pub struct Lock(#[allow(dead_code)] MutexGuard<'static, ()>);
+
+/// Waits for and takes the global TetGen lock.
+pub fn lock() -> Lock {
+    // A panic elsewhere while holding the lock leaves TetGen's state as good
+    // as any other call would: recover the guard from a poisoned mutex.
+    Lock(TETGEN.lock().unwrap_or_else(|e| e.into_inner()))
+}
+
 fn invalid(m: impl Into<String>) -> Error {
     Error::InvalidInput(m.into())
 }
@@ -455,6 +471,13 @@ unsafe fn copy_out<T: Copy>(p: *const T, n: i64) -> Vec<T> {
 /// `switches` are TetGen's command-line switches without the dash
 /// (e.g. `"pq1.414a0.1AQ"`). Calls are serialised by a global mutex.
 pub fn tetrahedralize(switches: &str, input: &Input) -> Result<Output, Error> {
+    let lock = lock();
+    tetrahedralize_locked(&lock, switches, input)
+}
+
+/// [`tetrahedralize`] for a caller that holds the global lock already
+/// (taken with [`lock`], e.g. in a child process forked while holding it).
+pub fn tetrahedralize_locked(_lock: &Lock, switches: &str, input: &Input) -> Result<Output, Error> {
     validate(input)?;
     let sw = CString::new(switches).map_err(|_| invalid("switches contain a NUL byte"))?;
     let raw_in = raw::RawInput {
@@ -495,11 +518,9 @@ pub fn tetrahedralize(switches: &str, input: &Input) -> Result<Output, Error> {
         trifaces: std::ptr::null(),
         trifacemarkers: std::ptr::null(),
     };
-    // A panic elsewhere while holding the lock leaves TetGen's state as good
-    // as any other call would: recover the guard from a poisoned mutex.
-    let _guard = TETGEN.lock().unwrap_or_else(|e| e.into_inner());
     // SAFETY: `validate` checked every count, length and index; the pointers
-    // borrow `input`, which outlives the call; the shim copies what it keeps.
+    // borrow `input`, which outlives the call; the shim copies what it keeps;
+    // `_lock` proves that no other call runs at the same time.
     let code = unsafe { raw::tg_tetrahedralize(sw.as_ptr(), &raw_in, &mut out) };
     if code != 0 {
         return Err(Error::Tetgen(code));
@@ -622,6 +643,30 @@ mod tests {
         let mut seen: Vec<i32> = out.trifacemarkers.clone();
         seen.sort_unstable();
         assert_eq!(seen, vec![1, 1, 2, 2, 3, 3, 4, 4, 5, 5, 6, 6]);
+    }
+
+    #[test]
+    fn a_caller_holding_the_lock_meshes_with_tetrahedralize_locked() {
+        let (p, fp, pv, v, m) = cube();
+        let input = Input {
+            points: &p,
+            facet_polygon_counts: &fp,
+            polygon_vertex_counts: &pv,
+            polygon_vertices: &v,
+            facet_markers: Some(&m),
+            ..Default::default()
+        };
+        let lock = lock();
+        let out = tetrahedralize_locked(&lock, "pQ", &input).unwrap();
+        drop(lock);
+        let vol: f64 = out
+            .tets
+            .chunks_exact(4)
+            .map(|t| tet_volume(&out.points, t).abs())
+            .sum();
+        assert!((vol - 1.0).abs() < 1e-12, "volume {vol}");
+        // The lock is free again: the locking entry point works.
+        assert_eq!(tetrahedralize("pQ", &input).unwrap(), out);
     }
 
     #[test]

@@ -570,30 +570,76 @@ pub struct MeshArgs {
     pub max_volume: Option<f64>,
     /// `--switches`.
     pub switches: Option<String>,
+    /// `--time-limit` in seconds (`None`: no limit).
+    pub time_limit: Option<f64>,
 }
 
-/// `tetrefine mesh`: fills a closed surface with TetGen. Errors: `Ok(Err)` is
-/// a file error, `Err` any other.
+/// Why [`mesh_surface`] failed, by the Python exception it becomes.
 #[cfg(feature = "tetgen")]
-pub fn mesh_surface(surface: Surface<'_>, a: MeshArgs) -> Result<Result<TetMesh, String>, String> {
+pub enum MeshError {
+    /// The surface file cannot be read (`OSError`).
+    File(String),
+    /// A bad option or surface, or a TetGen error (`ValueError`).
+    Value(String),
+    /// TetGen ran past the time limit and was stopped (`TimeoutError`).
+    Timeout(String),
+    /// TetGen's process died by a signal, or could not be run (`RuntimeError`).
+    Crash(String),
+}
+
+/// `tetrefine mesh`: fills a closed surface with TetGen, which runs in a
+/// child process (a crash of TetGen is an error, never the end of the
+/// interpreter) under the optional time limit. The messages of a timeout or
+/// a crash name the surface (its path, or its size for arrays).
+#[cfg(feature = "tetgen")]
+pub fn mesh_surface(surface: Surface<'_>, a: MeshArgs) -> Result<TetMesh, MeshError> {
+    use std::time::Duration;
     use tetrefine::io::Plc;
-    use tetrefine::tetgen::{switches, tetrahedralize, Options};
+    use tetrefine::tetgen::{switches, tetrahedralize, Isolation, Options, TetgenError};
+    let time_limit = match a.time_limit {
+        None => None,
+        Some(t) if t.is_finite() && t > 0.0 && t < 1e9 => {
+            Some(Duration::from_secs_f64(t).max(Duration::from_nanos(1)))
+        }
+        Some(t) => {
+            return Err(MeshError::Value(format!(
+                "time_limit={t}: give a positive number of seconds, or None for no limit"
+            )))
+        }
+    };
     let opts = Options {
         min_ratio: a.min_ratio,
         min_dihedral: a.min_dihedral,
         max_volume: a.max_volume,
         switches: a.switches,
         size_field: None,
+        isolation: Isolation::Child { time_limit },
     };
-    switches(&opts, false, "").map_err(|e| e.to_string())?;
-    let plc = match surface {
+    switches(&opts, false, "").map_err(|e| MeshError::Value(e.to_string()))?;
+    let (plc, name) = match surface {
         Surface::File(p) => match Plc::read(p) {
-            Ok(plc) => plc,
-            Err(e) => return Ok(Err(e.to_string())),
+            Ok(plc) => (plc, p.display().to_string()),
+            Err(e) => return Err(MeshError::File(e.to_string())),
         },
-        Surface::Triangles(points, tris) => Plc::from_triangles(points, &tris),
+        Surface::Triangles(points, tris) => {
+            let name = format!(
+                "the surface of {} points and {} triangles",
+                points.len(),
+                tris.len()
+            );
+            (Plc::from_triangles(points, &tris), name)
+        }
     };
-    let mut mesh = tetrahedralize(&plc, &opts).map_err(|e| e.to_string())?;
+    let mut mesh = tetrahedralize(&plc, &opts).map_err(|e| match e {
+        TetgenError::TimedOut { .. } => MeshError::Timeout(format!(
+            "{name}: {e}: time_limit={} (a looser quality bound or a larger maximum volume finishes sooner)",
+            a.time_limit.unwrap_or(0.0)
+        )),
+        TetgenError::Crashed { .. } | TetgenError::Child(_) => {
+            MeshError::Crash(format!("{name}: {e}"))
+        }
+        e => MeshError::Value(e.to_string()),
+    })?;
     mesh.compact();
-    Ok(Ok(mesh))
+    Ok(mesh)
 }

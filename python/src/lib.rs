@@ -820,9 +820,19 @@ fn _panic_for_tests(py: Python<'_>) -> PyResult<()> {
 ///                 guarantee; TetGen -q<R>/<DEG>).
 ///   max_volume    Largest tet volume (TetGen -a).
 ///   switches      More TetGen switches, appended.
+///   time_limit    Seconds TetGen may run (None: no limit) — the CLI's
+///                 --time-limit. Past it TetGen is stopped and TimeoutError
+///                 is raised. Some switches make TetGen refine for hours.
+///
+/// TetGen runs in a child process forked for the call (Linux/Unix), so a
+/// TetGen that crashes raises RuntimeError naming the surface and the
+/// signal (e.g. SIGSEGV) instead of killing the interpreter, and the time
+/// limit kills only the child. The mesh is the one TetGen makes in-process.
+/// Raises FileNotFoundError / OSError for an unreadable file and ValueError
+/// for bad options, a surface TetGen may not be given, or TetGen's errors.
 #[cfg(feature = "tetgen")]
 #[pyfunction]
-#[pyo3(signature = (surface, *, min_ratio=None, min_dihedral=None, max_volume=None, switches=None))]
+#[pyo3(signature = (surface, *, min_ratio=None, min_dihedral=None, max_volume=None, switches=None, time_limit=None))]
 fn mesh_surface(
     py: Python<'_>,
     surface: &Bound<'_, PyAny>,
@@ -830,12 +840,14 @@ fn mesh_surface(
     min_dihedral: Option<f64>,
     max_volume: Option<f64>,
     switches: Option<String>,
+    time_limit: Option<f64>,
 ) -> PyResult<Mesh> {
     let args = core_api::MeshArgs {
         min_ratio,
         min_dihedral,
         max_volume,
         switches,
+        time_limit,
     };
     let path: Option<PathBuf> = surface.extract().ok();
     let result = if let Some(p) = &path {
@@ -878,10 +890,15 @@ fn mesh_surface(
             core_api::mesh_surface(core_api::Surface::Triangles(points, tris), args)
         })?
     };
+    // A Ctrl-C that killed TetGen's child (same process group) is raised
+    // as KeyboardInterrupt, not as the child's death.
+    py.check_signals()?;
     match result {
-        Ok(Ok(mesh)) => Ok(Mesh::new_plain(mesh, BuildNotes::default())),
-        Ok(Err(file)) => Err(PyOSError::new_err(file)),
-        Err(m) => Err(PyValueError::new_err(m)),
+        Ok(mesh) => Ok(Mesh::new_plain(mesh, BuildNotes::default())),
+        Err(core_api::MeshError::File(m)) => Err(PyOSError::new_err(m)),
+        Err(core_api::MeshError::Value(m)) => Err(PyValueError::new_err(m)),
+        Err(core_api::MeshError::Timeout(m)) => Err(pyo3::exceptions::PyTimeoutError::new_err(m)),
+        Err(core_api::MeshError::Crash(m)) => Err(PyRuntimeError::new_err(m)),
     }
 }
 

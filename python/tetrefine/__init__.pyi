@@ -151,4 +151,5 @@ def mesh_surface(
     min_dihedral: float | None = None,
     max_volume: float | None = None,
     switches: str | None = None,
+    time_limit: float | None = None,
 ) -> Mesh: ...

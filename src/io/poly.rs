@@ -233,6 +233,7 @@ fn read_seeds(lines: &mut Lines, plc: &mut Plc) -> Result<(), IoError> {
     for _ in 0..n {
         let (l, t) = lines.next("a hole")?;
         plc.holes.push(lines.point3(l, &t, 1)?);
+        plc.seed_lines.holes.push(l);
     }
     if lines.at_end() {
         return Ok(());
@@ -261,6 +262,7 @@ fn read_seeds(lines: &mut Lines, plc: &mut Plc) -> Result<(), IoError> {
             attribute: a as i32,
             max_volume,
         });
+        plc.seed_lines.regions.push(l);
     }
     Ok(())
 }

@@ -1,5 +1,61 @@
 //! [`PlcError`]: why a PLC cannot be meshed.
 
+/// `" (line N)"`, or nothing without a line.
+fn on_line(line: Option<usize>) -> String {
+    line.map_or_else(String::new, |l| format!(" (line {l})"))
+}
+
+impl PlcError {
+    /// The error with the lines of its seeds filled in from `lines` (the
+    /// lines the seeds were read from; see [`crate::io::SeedLines`]).
+    pub(crate) fn with_seed_lines(self, lines: &super::SeedLines) -> PlcError {
+        let at = |v: &[usize], i: usize| i.checked_sub(1).and_then(|i| v.get(i)).copied();
+        match self {
+            PlcError::SeedOnFacet {
+                what,
+                index,
+                facet,
+                line,
+            } => PlcError::SeedOnFacet {
+                what,
+                index,
+                facet,
+                line: line.or_else(|| {
+                    at(
+                        if what == "hole" {
+                            &lines.holes
+                        } else {
+                            &lines.regions
+                        },
+                        index,
+                    )
+                }),
+            },
+            PlcError::SeedOutside {
+                index,
+                coords,
+                line,
+            } => PlcError::SeedOutside {
+                index,
+                coords,
+                line: line.or_else(|| at(&lines.regions, index)),
+            },
+            PlcError::SeedInHole {
+                index,
+                hole,
+                line,
+                hole_line,
+            } => PlcError::SeedInHole {
+                index,
+                hole,
+                line: line.or_else(|| at(&lines.regions, index)),
+                hole_line: hole_line.or_else(|| at(&lines.holes, hole)),
+            },
+            e => e,
+        }
+    }
+}
+
 /// Why a PLC cannot be meshed. Point, facet, polygon, hole and region numbers
 /// are 1-based, in the order of the [`crate::io::Plc`]'s lists.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
@@ -104,7 +160,7 @@ pub enum PlcError {
         b: u64,
     },
     /// A hole or region seed lies on a facet instead of strictly inside a cell.
-    #[error("{what} {index} lies on facet {facet}: seeds must lie strictly inside a region")]
+    #[error("{what} {index}{} lies on facet {facet}: seeds must lie strictly inside a region", on_line(*.line))]
     SeedOnFacet {
         /// "hole" or "region".
         what: &'static str,
@@ -112,24 +168,35 @@ pub enum PlcError {
         index: usize,
         /// 1-based facet number.
         facet: usize,
+        /// 1-based line of the seed in the file it was read from, if known
+        /// ([`crate::io::SeedLines`]).
+        line: Option<usize>,
     },
     /// A region seed lies in no bounded cell: outside the surface.
-    #[error("region {index} has its seed at {coords:?}, outside the surface: a region seed must lie inside the volume (TetGen crashes on it)")]
+    #[error("region {index}{} has its seed at {coords:?}, outside the surface: a region seed must lie inside the volume (TetGen crashes on it)", on_line(*.line))]
     SeedOutside {
         /// 1-based region number.
         index: usize,
         /// The seed.
         coords: [f64; 3],
+        /// 1-based line of the seed in the file it was read from, if known.
+        line: Option<usize>,
     },
     /// A region seed lies in a cell that a hole seed empties.
     #[error(
-        "region {index} has its seed in the cell that hole {hole} empties: the region would vanish"
+        "region {index}{} has its seed in the cell that hole {hole}{} empties: the region would vanish",
+        on_line(*.line),
+        on_line(*.hole_line)
     )]
     SeedInHole {
         /// 1-based region number.
         index: usize,
         /// 1-based number of the hole seed of the same cell.
         hole: usize,
+        /// 1-based line of the region seed in its file, if known.
+        line: Option<usize>,
+        /// 1-based line of the hole seed in its file, if known.
+        hole_line: Option<usize>,
     },
     /// The facets do not split space into cells consistently.
     #[error("the facets do not enclose volumes consistently ({0}); do they intersect?")]

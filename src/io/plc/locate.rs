@@ -248,6 +248,7 @@ impl Analysis {
                             what,
                             index: index + 1,
                             facet: self.pieces[k].facet + 1,
+                            line: None,
                         });
                     }
                     continue; // the segment leaves the plane at once

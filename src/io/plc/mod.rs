@@ -73,6 +73,22 @@ pub struct Plc {
     pub holes: Vec<[f64; 3]>,
     /// Region seeds.
     pub regions: Vec<Region>,
+    /// The lines of the text file the seeds were read from, so that the
+    /// seed errors of [`Plc::analyze`] name them; empty for a PLC built in
+    /// code or read from a format without seeds.
+    pub seed_lines: SeedLines,
+}
+
+/// The 1-based lines of a `.poly`/`.smesh` file that hold the seeds of a
+/// [`Plc`]: `holes[i]` is the line of `plc.holes[i]`, `regions[i]` that of
+/// `plc.regions[i]`. A list shorter than its seeds (e.g. empty) leaves the
+/// seeds past its end without a line.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct SeedLines {
+    /// Line of each volume hole seed.
+    pub holes: Vec<usize>,
+    /// Line of each region seed.
+    pub regions: Vec<usize>,
 }
 
 /// What [`Plc::analyze`] finds out about the volume a PLC encloses.
@@ -177,6 +193,7 @@ impl Plc {
                 .collect(),
             holes: Vec::new(),
             regions: Vec::new(),
+            seed_lines: SeedLines::default(),
         }
     }
 

@@ -292,3 +292,138 @@ fn seeds_are_located_exactly() {
     let below = f64::from_bits(0.25f64.to_bits() - 1);
     seeded(nested, [0.5, 0.5, below]).validate().unwrap();
 }
+
+/// `plc` as the text of a 1-based `.poly` (or `.smesh`) file with comment
+/// and blank lines between its sections, and the 1-based lines on which it
+/// put each hole seed and each region seed (counted here, as written).
+fn seed_file_text(plc: &Plc, smesh: bool) -> (String, Vec<usize>, Vec<usize>) {
+    let mut lines: Vec<String> = vec!["# a test surface".into(), String::new()];
+    lines.push(format!("{} 3 0 0", plc.points.len()));
+    for (i, p) in plc.points.iter().enumerate() {
+        lines.push(format!("{} {:?} {:?} {:?}", i + 1, p[0], p[1], p[2]));
+    }
+    lines.push("# facets".into());
+    lines.push(format!("{} 1", plc.facets.len()));
+    for f in &plc.facets {
+        let ids = |p: &Vec<u32>| {
+            let v: Vec<String> = p.iter().map(|v| (v + 1).to_string()).collect();
+            format!("{} {}", p.len(), v.join(" "))
+        };
+        if smesh {
+            lines.push(format!("{} {}", ids(&f.polygons[0]), f.marker));
+        } else {
+            lines.push(format!("{} 0 {}", f.polygons.len(), f.marker));
+            lines.extend(f.polygons.iter().map(ids));
+        }
+    }
+    lines.push(String::new());
+    lines.push("# holes".into());
+    lines.push(plc.holes.len().to_string());
+    let mut hole_lines = Vec::new();
+    for (i, h) in plc.holes.iter().enumerate() {
+        lines.push(format!("{} {:?} {:?} {:?}", i + 1, h[0], h[1], h[2]));
+        hole_lines.push(lines.len());
+    }
+    lines.push("# regions".into());
+    lines.push(plc.regions.len().to_string());
+    let mut region_lines = Vec::new();
+    for (i, r) in plc.regions.iter().enumerate() {
+        lines.push("# the next seed".into());
+        let p = r.point;
+        lines.push(format!(
+            "{} {:?} {:?} {:?} {}",
+            i + 1,
+            p[0],
+            p[1],
+            p[2],
+            r.attribute
+        ));
+        region_lines.push(lines.len());
+    }
+    (lines.join("\n") + "\n", hole_lines, region_lines)
+}
+
+/// Issue 21: the seed errors of a `.poly`/`.smesh` file name the line of
+/// the seed (outside the surface, in a hole's cell, on a facet); a PLC built
+/// in code names none.
+#[test]
+fn seed_errors_name_the_line_of_the_seed_in_the_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let region = |x: [f64; 3], attribute: i32| Region {
+        point: x,
+        attribute,
+        max_volume: None,
+    };
+    // A cube with a good seed and, second, one outside (z = 2).
+    let mut cube = unit_cube();
+    cube.regions = vec![region([0.5; 3], 1), region([0.5, 0.5, 2.0], 2)];
+    for smesh in [false, true] {
+        let (text, _, region_lines) = seed_file_text(&cube, smesh);
+        let path = dir
+            .path()
+            .join(if smesh { "cube.smesh" } else { "cube.poly" });
+        std::fs::write(&path, text).unwrap();
+        let read = Plc::read(&path).unwrap();
+        assert_eq!(read.seed_lines.regions, region_lines, "{smesh}");
+        let e = read.validate().unwrap_err();
+        assert_eq!(
+            e,
+            PlcError::SeedOutside {
+                index: 2,
+                coords: [0.5, 0.5, 2.0],
+                line: Some(region_lines[1]),
+            },
+            "{smesh}"
+        );
+        let want = format!("region 2 (line {}) has its seed at", region_lines[1]);
+        assert!(e.to_string().starts_with(&want), "{smesh}: {e}");
+    }
+    // Nested boxes, the inner one emptied by a hole; a region seed in it.
+    let mut nested = unit_cube();
+    add_box(&mut nested, [0.25; 3], [0.75; 3]);
+    nested.holes = vec![[0.5; 3]];
+    nested.regions = vec![region([0.1; 3], 1), region([0.5, 0.5, 0.6], 2)];
+    let (text, hole_lines, region_lines) = seed_file_text(&nested, false);
+    let path = dir.path().join("nested.poly");
+    std::fs::write(&path, text).unwrap();
+    let e = Plc::read(&path).unwrap().validate().unwrap_err();
+    assert_eq!(
+        e,
+        PlcError::SeedInHole {
+            index: 2,
+            hole: 1,
+            line: Some(region_lines[1]),
+            hole_line: Some(hole_lines[0]),
+        }
+    );
+    let want = format!(
+        "region 2 (line {}) has its seed in the cell that hole 1 (line {}) empties",
+        region_lines[1], hole_lines[0]
+    );
+    assert!(e.to_string().starts_with(&want), "{e}");
+    // A seed on a facet (x = 1).
+    let mut on = unit_cube();
+    on.regions = vec![region([1.0, 0.5, 0.5], 1)];
+    let (text, _, region_lines) = seed_file_text(&on, false);
+    let path = dir.path().join("on.poly");
+    std::fs::write(&path, text).unwrap();
+    let e = Plc::read(&path).unwrap().validate().unwrap_err();
+    assert!(
+        matches!(e, PlcError::SeedOnFacet { what: "region", index: 1, line: Some(l), .. } if l == region_lines[0]),
+        "{e:?}"
+    );
+    assert!(
+        e.to_string().starts_with(&format!(
+            "region 1 (line {}) lies on facet",
+            region_lines[0]
+        )),
+        "{e}"
+    );
+    // Built in code: no line, and the message says none.
+    let e = seeded(unit_cube(), [0.5, 0.5, 2.0]).validate().unwrap_err();
+    assert!(
+        matches!(e, PlcError::SeedOutside { line: None, .. }),
+        "{e:?}"
+    );
+    assert!(e.to_string().starts_with("region 1 has its seed at"), "{e}");
+}

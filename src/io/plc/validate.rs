@@ -62,11 +62,16 @@ fn scaled(plc: &Plc, s: f64) -> Plc {
                 max_volume: r.max_volume.map(|v| v * s * s * s),
             })
             .collect(),
+        seed_lines: plc.seed_lines.clone(),
     }
 }
 
 impl Analysis {
     pub(super) fn run(plc: &Plc) -> Result<PlcVolume, PlcError> {
+        Analysis::run_scaled(plc).map_err(|e| e.with_seed_lines(&plc.seed_lines))
+    }
+
+    fn run_scaled(plc: &Plc) -> Result<PlcVolume, PlcError> {
         if let Some(s) = scale_of(plc) {
             // Checked in exactly scaled coordinates; volumes scaled back (a
             // volume beyond the doubles' range becomes infinite).

@@ -285,6 +285,8 @@ impl Analysis {
                         return Err(PlcError::SeedInHole {
                             index: i + 1,
                             hole: h + 1,
+                            line: None,
+                            hole_line: None,
                         });
                     }
                 }
@@ -292,6 +294,7 @@ impl Analysis {
                     return Err(SeedOutside {
                         index: i + 1,
                         coords: r.point,
+                        line: None,
                     })
                 }
             }

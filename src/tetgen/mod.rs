@@ -16,11 +16,43 @@
 //! input encloses (relative 1e-9, plus the slack of non-planar facets).
 //! TetGen's own errors come back as [`TetgenError::Tetgen`]; the process
 //! survives them, and calls are serialised (TetGen is not thread-safe).
+//!
+//! With [`Options::isolation`] = [`Isolation::Child`], TetGen runs in a child
+//! process forked for the call (Unix): a TetGen that crashes comes back as
+//! [`TetgenError::Crashed`] naming the signal, and one that runs longer than
+//! the time limit is killed and comes back as [`TetgenError::TimedOut`]. The
+//! caller survives both. The result is the same mesh as in-process (TetGen
+//! is deterministic; its output arrays are sent back over a pipe unchanged).
+
+mod child;
 
 use crate::geom::tet_volume;
 use crate::io::plc::{Plc, PlcError};
 use crate::mesh::{face_key, MeshData, TetMesh, NO_ADJ};
 use std::collections::{BTreeMap, HashMap};
+use std::time::Duration;
+
+/// Where TetGen runs; see [`Options::isolation`].
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub enum Isolation {
+    /// In the calling process (the default). Fastest, but a crash of TetGen
+    /// (an assertion or a segmentation fault on input the checks let
+    /// through) ends the process, and nothing can stop a run that does not
+    /// finish.
+    #[default]
+    InProcess,
+    /// In a child process forked for the call (`fork`, the result sent back
+    /// over a pipe; Unix only). A child that dies by a signal gives
+    /// [`TetgenError::Crashed`]; with `time_limit`, a child still running
+    /// after that long is killed (`SIGKILL`) and the call gives
+    /// [`TetgenError::TimedOut`]. On Linux the child also dies with the
+    /// thread that forked it, so a caller killed meanwhile leaves no TetGen
+    /// running. Costs a fork and a copy of the output (milliseconds).
+    Child {
+        /// Longest time TetGen may run (`None`: no limit).
+        time_limit: Option<Duration>,
+    },
+}
 
 /// How to mesh or refine. Every field is optional.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -38,6 +70,9 @@ pub struct Options {
     /// [`refine`] only: target edge length at each point of the mesh, indexed
     /// like its points (TetGen `-m` with one size per point).
     pub size_field: Option<Vec<f64>>,
+    /// Where TetGen runs: in this process (the default) or in a child
+    /// process, with an optional time limit.
+    pub isolation: Isolation,
 }
 
 /// Why meshing or refining failed.
@@ -61,6 +96,34 @@ pub enum TetgenError {
     /// TetGen's result is not a valid mesh.
     #[error("TetGen's output is not a valid mesh: {0}")]
     InvalidOutput(String),
+    /// TetGen ran longer than the time limit of [`Isolation::Child`]; its
+    /// process was killed.
+    #[error("TetGen did not finish within {seconds} s and was stopped (switches -{switches})")]
+    TimedOut {
+        /// The time limit, in seconds.
+        seconds: f64,
+        /// The switches used.
+        switches: String,
+    },
+    /// TetGen's child process ([`Isolation::Child`]) died by a signal: TetGen
+    /// crashed (or the process was killed from outside), and no mesh came
+    /// back. The caller's process is unharmed.
+    #[error(
+        "TetGen crashed: its process died by signal {signal} ({}) while {input} (switches -{switches})",
+        child::signal_name(*.signal)
+    )]
+    Crashed {
+        /// The signal number (`11` is `SIGSEGV`, `6` `SIGABRT`).
+        signal: i32,
+        /// The switches used.
+        switches: String,
+        /// What TetGen was given, e.g. "meshing 8 points and 6 facets".
+        input: String,
+    },
+    /// TetGen's child process could not be started or ended without a
+    /// result (fork or pipe failure, an exit without a result).
+    #[error("{0}")]
+    Child(String),
     /// TetGen's mesh does not fill the volume it should.
     #[error(
         "TetGen's mesh has volume {got} but the input encloses {expected} (switches -{switches})"
@@ -77,6 +140,111 @@ pub enum TetgenError {
 
 fn ffi_error(e: tetgen_ffi::Error) -> TetgenError {
     TetgenError::Tetgen(e.message())
+}
+
+/// TetGen's result (or error) as bytes, for the pipe of a child process.
+fn encode(r: &Result<tetgen_ffi::Output, tetgen_ffi::Error>) -> Vec<u8> {
+    use child::wire::{put_f64s, put_i32s, put_len};
+    let mut b = Vec::new();
+    match r {
+        Ok(o) => {
+            b.push(0);
+            b.reserve(
+                8 * (o.points.len() + o.tet_attributes.len() + 5)
+                    + 4 * (o.tets.len() + o.trifaces.len() + o.trifacemarkers.len()),
+            );
+            put_f64s(&mut b, &o.points);
+            put_i32s(&mut b, &o.tets);
+            put_f64s(&mut b, &o.tet_attributes);
+            put_i32s(&mut b, &o.trifaces);
+            put_i32s(&mut b, &o.trifacemarkers);
+        }
+        Err(tetgen_ffi::Error::InvalidInput(m)) => {
+            b.push(1);
+            put_len(&mut b, m.len());
+            b.extend_from_slice(m.as_bytes());
+        }
+        Err(tetgen_ffi::Error::Tetgen(code)) => {
+            b.push(2);
+            put_i32s(&mut b, &[*code]);
+        }
+    }
+    b
+}
+
+/// The inverse of [`encode`]; `None` for bytes it did not write.
+fn decode(bytes: &[u8]) -> Option<Result<tetgen_ffi::Output, tetgen_ffi::Error>> {
+    let mut r = child::wire::Reader(bytes);
+    let v = match r.u8()? {
+        0 => Ok(tetgen_ffi::Output {
+            points: r.f64s()?,
+            tets: r.i32s()?,
+            tet_attributes: r.f64s()?,
+            trifaces: r.i32s()?,
+            trifacemarkers: r.i32s()?,
+        }),
+        1 => Err(tetgen_ffi::Error::InvalidInput(r.string()?)),
+        2 => match r.i32s()?.as_slice() {
+            [code] => Err(tetgen_ffi::Error::Tetgen(*code)),
+            _ => return None,
+        },
+        _ => return None,
+    };
+    r.is_empty().then_some(v)
+}
+
+/// Runs TetGen on `input` with switches `sw`, where `isolation` says;
+/// `what` says what the input is for [`TetgenError::Crashed`].
+fn run_tetgen(
+    sw: &str,
+    input: &tetgen_ffi::Input,
+    isolation: Isolation,
+    what: impl FnOnce() -> String,
+) -> Result<tetgen_ffi::Output, TetgenError> {
+    let time_limit = match isolation {
+        Isolation::InProcess => {
+            return quiet_stdout(|| tetgen_ffi::tetrahedralize(sw, input)).map_err(ffi_error)
+        }
+        Isolation::Child { time_limit } => time_limit,
+    };
+    if let Some(t) = time_limit {
+        if t.is_zero() {
+            return Err(TetgenError::Options(
+                "a time limit of 0 s leaves TetGen no time (use None for no limit)".into(),
+            ));
+        }
+    }
+    // Flush what the caller printed, so that the child does not print it again.
+    {
+        use std::io::Write;
+        let _ = std::io::stdout().flush();
+        let _ = std::io::stderr().flush();
+        // SAFETY: fflush(NULL) flushes every C stream; no preconditions.
+        unsafe { libc::fflush(std::ptr::null_mut()) };
+    }
+    let lock = tetgen_ffi::lock();
+    let bytes = child::run(time_limit, lock, |lock| {
+        encode(&tetgen_ffi::tetrahedralize_locked(lock, sw, input))
+    });
+    match bytes {
+        Ok(b) => match decode(&b) {
+            Some(r) => r.map_err(ffi_error),
+            None => Err(TetgenError::Child(format!(
+                "TetGen's child process sent back {} bytes that are not a whole result",
+                b.len()
+            ))),
+        },
+        Err(child::ChildError::TimedOut) => Err(TetgenError::TimedOut {
+            seconds: time_limit.map_or(0.0, |t| t.as_secs_f64()),
+            switches: sw.to_string(),
+        }),
+        Err(child::ChildError::Signal(signal)) => Err(TetgenError::Crashed {
+            signal,
+            switches: sw.to_string(),
+            input: what(),
+        }),
+        Err(child::ChildError::Failed(m)) => Err(TetgenError::Child(m)),
+    }
 }
 
 /// Switches this crate never passes to TetGen, with the reason.
@@ -471,7 +639,13 @@ pub fn tetrahedralize(plc: &Plc, opts: &Options) -> Result<TetMesh, TetgenError>
         regions: &regions,
         ..Default::default()
     };
-    let out = quiet_stdout(|| tetgen_ffi::tetrahedralize(&sw, &input)).map_err(ffi_error)?;
+    let out = run_tetgen(&sw, &input, opts.isolation, || {
+        format!(
+            "meshing {} points and {} facets",
+            points.len() / 3,
+            plc.facets.len()
+        )
+    })?;
     let mesh = build_mesh(out, &sw)?;
     check_volume(
         analysis.enclosed,
@@ -565,7 +739,9 @@ pub fn refine(mesh: &TetMesh, opts: &Options) -> Result<TetMesh, TetgenError> {
         trifacemarkers: &trifacemarkers,
         ..Default::default()
     };
-    let out = quiet_stdout(|| tetgen_ffi::tetrahedralize(&sw, &input)).map_err(ffi_error)?;
+    let out = run_tetgen(&sw, &input, opts.isolation, || {
+        format!("refining {} points and {} tets", m.n_points(), ids.len())
+    })?;
     let refined = build_mesh(out, &sw)?;
     let before = region_volumes(&m);
     let after = region_volumes(&refined);
