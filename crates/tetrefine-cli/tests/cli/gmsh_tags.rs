@@ -342,8 +342,8 @@ fn gmsh_element_data_is_read_in_every_layout_and_carried_over_by_parent() {
         for t in 0..d.tets.len() {
             let c = centroid(&d, t);
             assert_eq!(rho.values[t], density_at(c), "{f}: tet {t}");
-            for a in 0..3 {
-                assert!((cen.entry(t)[a] - c[a]).abs() <= 1e-12, "{f}: tet {t}");
+            for (x, y) in cen.entry(t).iter().zip(c) {
+                assert!((x - y).abs() <= 1e-12, "{f}: tet {t}");
             }
         }
         centroids = (0..d.tets.len()).map(|t| centroid(&d, t)).collect();
