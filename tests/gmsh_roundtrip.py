@@ -11,9 +11,16 @@ entities' worth of elements:
   elements than before (the √3 step splits every tet and boundary face);
   groups tetrefine adds for the features it detects are unnamed extras.
 
+Cell fields: the input's `$ElementData` view "density" (7.85 in the box
+x < 1, 8.96 in the box x > 1) comes back from `refine` in each variant as a
+Gmsh view with a value at every element: at every tet the density of the
+box its centroid is in (worked out here from Gmsh's own nodes), NaN at the
+triangles, lines and points.
+
 Usage: python3 tests/gmsh_roundtrip.py TETREFINE_BINARY   (needs `pip install gmsh`)
 """
 
+import math
 import os
 import subprocess
 import sys
@@ -42,6 +49,36 @@ def groups(path, v22=False):
             n += k
         out[(dim, tag)] = (gmsh.model.getPhysicalName(dim, tag), n)
     return out
+
+
+def check_density(path):
+    """The "density" view of `path` as Gmsh reads it (see the docstring);
+    returns the number of tets checked."""
+    for v in gmsh.view.getTags():
+        gmsh.view.remove(v)
+    gmsh.open(path)
+    views = {gmsh.view.option.getString(v, "Name"): v for v in gmsh.view.getTags()}
+    assert "density" in views, (path, views)
+    _, tags, data, _, comps = gmsh.view.getModelData(views["density"], 0)
+    assert comps == 1, (path, comps)
+    value = {int(t): d[0] for t, d in zip(tags, data)}
+    nodes, coords, _ = gmsh.model.mesh.getNodes()
+    xyz = {int(n): coords[3 * i : 3 * i + 3] for i, n in enumerate(nodes)}
+    types, etags, enodes = gmsh.model.mesh.getElements()
+    n_elements = sum(len(t) for t in etags)
+    assert len(value) == n_elements, (path, len(value), n_elements)
+    tets = 0
+    for etype, et, en in zip(types, etags, enodes):
+        k = len(en) // len(et)
+        for i, t in enumerate(et):
+            v = value[int(t)]
+            if etype != 4:
+                assert math.isnan(v), (path, etype, t, v)
+                continue
+            x = sum(xyz[int(n)][0] for n in en[k * i : k * i + k]) / k
+            assert v == (7.85 if x < 1 else 8.96), (path, t, x, v)
+            tets += 1
+    return tets
 
 
 def main(tetrefine):
@@ -73,7 +110,9 @@ def main(tetrefine):
                 assert got[key][1] >= n, (fmt, "refine", key, got[key], n)
         extra = {k: v for k, v in got.items() if k not in want}
         assert all(name == "" for name, _ in extra.values()), extra
-        print(f"gmsh reads MSH {fmt}: {len(want)} named groups kept through convert and refine")
+        tets = check_density(out)
+        assert tets > 3 * 1455, (fmt, tets)
+        print(f"gmsh reads MSH {fmt}: {len(want)} named groups kept through convert and refine, the cell field at {tets} tets")
     gmsh.finalize()
 
 

@@ -200,3 +200,52 @@ pub fn reals(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<Vec<f64>> {
     let b = b.cast::<numpy::PyArray1<f64>>()?;
     Ok(b.readonly().as_array().iter().copied().collect())
 }
+
+/// A table of reals, `(n,)` (one component) or `(n, k)`, as float64: the
+/// component count and the values row after row (a field or a size map).
+pub fn table(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<(usize, Vec<f64>)> {
+    let a = as_ndarray(obj)?;
+    let kind = a.dtype().kind();
+    if !matches!(kind, b'f' | b'i' | b'u' | b'b') {
+        return Err(PyTypeError::new_err(format!(
+            "{name} must hold real numbers, got dtype {}",
+            a.dtype().str()?
+        )));
+    }
+    let k = match a.shape() {
+        [_] => 1,
+        [_, k] if *k >= 1 => *k,
+        s => {
+            return Err(PyValueError::new_err(format!(
+                "{name} must have shape (n,) or (n, k), got {}",
+                shape_text(s)
+            )))
+        }
+    };
+    let np = obj.py().import("numpy")?;
+    let b = np.getattr("ascontiguousarray")?.call1((a, "float64"))?;
+    let b = b.cast::<numpy::PyArrayDyn<f64>>()?;
+    let values = b
+        .readonly()
+        .as_slice()
+        .map_err(|e| PyValueError::new_err(format!("{name}: {e}")))?
+        .to_vec();
+    Ok((k, values))
+}
+
+/// A dict `{name: array (n,) or (n, k)}` of fields (`arg` names the
+/// argument in messages), in the dict's order.
+pub fn fields(obj: &Bound<'_, PyAny>, arg: &str) -> PyResult<Vec<(String, usize, Vec<f64>)>> {
+    let d = obj
+        .cast::<pyo3::types::PyDict>()
+        .map_err(|_| PyTypeError::new_err(format!("{arg} must be a dict of name -> array")))?;
+    let mut out = Vec::with_capacity(d.len());
+    for (k, v) in d.iter() {
+        let name: String = k
+            .extract()
+            .map_err(|_| PyTypeError::new_err(format!("{arg}: field names must be strings")))?;
+        let (c, values) = table(&v, &format!("{arg}[{name:?}]"))?;
+        out.push((name, c, values));
+    }
+    Ok(out)
+}

@@ -277,6 +277,52 @@ pub struct RefineArgs {
     pub allow_empty: bool,
     /// `--allow-steps-zero`: `steps = 0` is not an error.
     pub allow_steps_zero: bool,
+    /// `--steps auto` (then `steps` is the cap, [`AUTO_SIZE_PASSES`]).
+    pub steps_auto: bool,
+    /// `--size` / `--size-array`: components (1 or 6) and values per point.
+    pub size: Option<(usize, Vec<f64>)>,
+    /// `--hsiz`.
+    pub hsiz: Option<f64>,
+    /// `--hmax`.
+    pub hmax: Option<f64>,
+    /// The input's point fields (`--fields`, `.vtu` point data).
+    pub point_fields: Vec<FieldIn>,
+    /// The input's cell fields, per input tet.
+    pub cell_fields: Vec<FieldIn>,
+    /// Carry the fields over (`--transfer`; `false`: `--no-transfer`).
+    pub transfer: bool,
+    /// Compute the vertex parent map (`--parent-map`) even without fields.
+    pub vertex_parents: bool,
+}
+
+/// Size passes of `steps="auto"` at most (the CLI's `--steps auto` cap).
+pub const AUTO_SIZE_PASSES: usize = tetrefine::AUTO_SIZE_PASSES;
+
+/// A named field: `components` values per entry, entry after entry.
+#[derive(Clone, Debug)]
+pub struct FieldIn {
+    /// The field's name.
+    pub name: String,
+    /// Values per entry.
+    pub components: usize,
+    /// The values.
+    pub values: Vec<f64>,
+}
+
+/// The vertex parent map (the CLI's `--parent-map` points section and
+/// `.vtu` arrays `parent_tet`, `parent_vertices`, `parent_bary`,
+/// `parent_outside`), per output point.
+#[derive(Clone, Debug, Default)]
+pub struct VertexParents {
+    /// The input tet holding the point (or nearest to it).
+    pub tet: Vec<u32>,
+    /// That tet's four vertices.
+    pub vertices: Vec<[u32; 4]>,
+    /// The point's barycentric coordinates for them.
+    pub bary: Vec<[f64; 4]>,
+    /// The point lies outside the input; `bary` give the nearest input
+    /// boundary point.
+    pub outside: Vec<bool>,
 }
 
 /// What went wrong in [`refine`]: bad options (a `ValueError`) or a file.
@@ -301,6 +347,73 @@ pub struct Refined {
     /// input, feature detection, the steps, parent location, compaction and
     /// the `marked` array.
     pub timings: String,
+    /// The parents and marked flags, when the transfer located them already.
+    pub located: Option<(Vec<u32>, Vec<bool>)>,
+    /// The point fields carried over (empty without transfer).
+    pub point_fields: Vec<FieldIn>,
+    /// The cell fields carried over.
+    pub cell_fields: Vec<FieldIn>,
+    /// The vertex parent map, when fields were carried over or it was asked for.
+    pub vertex_parents: Option<VertexParents>,
+}
+
+/// Checks the fields against the mesh: `n` entries of finite values each.
+fn check_fields(fields: &[FieldIn], n: usize, what: &str, arg: &str) -> Result<(), String> {
+    for f in fields {
+        if f.components == 0 || f.values.len() != n * f.components {
+            return Err(format!(
+                "{arg}[{:?}] has {} rows but the mesh has {n} {what}",
+                f.name,
+                f.values.len() / f.components.max(1)
+            ));
+        }
+        if let Some(i) = f.values.iter().position(|x| !x.is_finite()) {
+            return Err(format!(
+                "{arg}[{:?}]: value {} at row {} is not a finite number",
+                f.name,
+                f.values[i],
+                i / f.components
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// The size map of `size=` / `hsiz=` / `hmax=` over the points of `input`
+/// (the CLI's `--size-array`, `--hsiz`, `--hmax`: the library's
+/// [`tetrefine::SizeMap::from_values`] and [`tetrefine::SizeMap::cap`]).
+fn size_map(a: &RefineArgs, input: &TetMesh) -> Result<Option<tetrefine::SizeMap>, String> {
+    use tetrefine::SizeMap;
+    for (name, h) in [("hsiz", a.hsiz), ("hmax", a.hmax)] {
+        if let Some(h) = h {
+            if !(h > 0.0 && h.is_finite()) {
+                return Err(format!("{name}={h} must be a positive length"));
+            }
+        }
+    }
+    if a.size.is_some() && a.hsiz.is_some() {
+        return Err("give one size: size=... or hsiz=... (hmax caps either)".into());
+    }
+    let n = input.n_points();
+    let mut map = match &a.size {
+        Some((components, values)) => {
+            if values.len() != n * components {
+                return Err(format!(
+                    "size has {} rows but the mesh has {n} points",
+                    values.len() / components.max(&1)
+                ));
+            }
+            Some(SizeMap::from_values(*components, values).map_err(|e| format!("size: {e}"))?)
+        }
+        None => a.hsiz.map(|h| SizeMap::Iso(vec![h; n])),
+    };
+    if let Some(h) = a.hmax {
+        match map.as_mut() {
+            Some(m) => m.cap(h),
+            None => map = Some(SizeMap::Iso(vec![h; n])),
+        }
+    }
+    Ok(map)
 }
 
 /// Called at the start of every phase with (1-based step, phase name, live
@@ -383,6 +496,27 @@ pub fn refine(
             "steps=0 refines nothing; give steps >= 1 (or allow_steps_zero=True to get the mesh unrefined)".into(),
         ));
     }
+    let size = size_map(a, input).map_err(Value)?;
+    if size.is_some() {
+        if !a.marks.is_empty() || indicator.is_some() {
+            return Err(Value("a size map chooses what to refine itself: drop indicator/mark/region/box/sphere, or the size arguments".into()));
+        }
+        if stop_after.is_some() {
+            return Err(Value(
+                "stop_after names a phase of the √3 step; size-driven refinement has none".into(),
+            ));
+        }
+    } else if a.steps_auto {
+        return Err(Value("steps='auto' refines until every edge meets a size map: give size=..., hsiz=... or hmax=...".into()));
+    }
+    check_fields(&a.point_fields, input.n_points(), "points", "point_fields").map_err(Value)?;
+    check_fields(&a.cell_fields, input.n_tets(), "tets", "cell_fields").map_err(Value)?;
+    let has_fields = !a.point_fields.is_empty() || !a.cell_fields.is_empty();
+    if a.transfer && !has_fields {
+        return Err(Value(
+            "transfer=True: the mesh carries no point or cell field (give point_fields= or cell_fields=)".into(),
+        ));
+    }
     let st = strategy(&a.marks, indicator.is_some()).map_err(Value)?;
     let selection = match &st {
         Some(st) => {
@@ -442,31 +576,119 @@ pub fn refine(
     let mut steps = Vec::with_capacity(a.steps);
     // The library's step loop (the CLI's too): it selects the descendants of
     // the selection for every later step.
-    refine_with(&mut mesh, a.steps, &opts, &progress, |_, m, report| {
-        let mut value = serde_json::to_value(&report).unwrap_or_default();
+    let with_stats = |mut value: serde_json::Value, m: &TetMesh| {
         if a.stats {
             let stats = serde_json::to_value(MeshStats::compute(m)).unwrap_or_default();
             if let (Some(obj), serde_json::Value::Object(q)) = (value.as_object_mut(), stats) {
                 obj.insert("quality".into(), serde_json::Value::Object(q));
             }
         }
-        steps.push(value.to_string());
-    });
+        value.to_string()
+    };
+    if let Some(mut size) = size {
+        // The CLI's size loop: the floor is each pass's worst tet at its
+        // start (in the metric), the optimize phase after each pass; `auto`
+        // stops when no edge is long or no split was possible.
+        let sopts = tetrefine::SizeOptions {
+            quality_floor: None,
+            improve: tetrefine::ImproveOptions {
+                passes: a.opt_passes,
+                threshold: a.threshold,
+                ..tetrefine::ImproveOptions::default()
+            },
+        };
+        for s in 1..=a.steps {
+            hook(s, "size", mesh.n_tets() as u64);
+            let t = std::time::Instant::now();
+            let r = tetrefine::size_pass(&mut mesh, &mut size, &sopts);
+            let value = serde_json::json!({
+                "size_pass": s,
+                "long_edges": r.long_edges,
+                "split": r.split,
+                "refused": r.refused,
+                "long_after": r.long_after,
+                "tets": mesh.n_tets(),
+                "seconds": t.elapsed().as_secs_f64(),
+            });
+            steps.push(with_stats(value, &mesh));
+            if a.steps_auto && (r.long_after == 0 || r.split == 0) {
+                break;
+            }
+        }
+    } else {
+        // The library's step loop (the CLI's too): it selects the descendants of
+        // the selection for every later step.
+        refine_with(&mut mesh, a.steps, &opts, &progress, |_, m, report| {
+            let value = serde_json::to_value(&report).unwrap_or_default();
+            steps.push(with_stats(value, m));
+        });
+    }
     let t_steps = lap();
     mesh.compact();
     let t_compact = lap();
-    let timings = serde_json::json!({
+    // The CLI's transfer: parents located, every output point located in
+    // the input, point fields interpolated there, cell fields copied from
+    // the parents.
+    let transfer = has_fields && a.transfer;
+    let mut located = None;
+    let mut vertex_parents = None;
+    let (mut point_fields, mut cell_fields) = (Vec::new(), Vec::new());
+    if transfer || a.vertex_parents {
+        let (parents, marked) = locate(input, &mesh, selection.as_deref());
+        let locs = tetrefine::locate_points(input, &mesh);
+        if transfer {
+            point_fields = a
+                .point_fields
+                .iter()
+                .map(|f| FieldIn {
+                    name: f.name.clone(),
+                    components: f.components,
+                    values: tetrefine::interpolate_point_field(
+                        input.tet_slots(),
+                        &locs,
+                        &f.values,
+                        f.components,
+                    ),
+                })
+                .collect();
+            cell_fields = a
+                .cell_fields
+                .iter()
+                .map(|f| FieldIn {
+                    name: f.name.clone(),
+                    components: f.components,
+                    values: tetrefine::copy_cell_field(&parents, &f.values, f.components),
+                })
+                .collect();
+        }
+        vertex_parents = Some(VertexParents {
+            tet: locs.iter().map(|l| l.tet).collect(),
+            vertices: locs.iter().map(|l| input.tet(l.tet)).collect(),
+            bary: locs.iter().map(|l| l.bary).collect(),
+            outside: locs.iter().map(|l| l.outside).collect(),
+        });
+        located = Some((parents, marked));
+    }
+    let t_transfer = lap();
+    let mut timings = serde_json::json!({
         "copy": t_copy,
         "features": t_features,
         "steps": t_steps,
         "compact": t_compact,
-    })
-    .to_string();
+    });
+    if located.is_some() {
+        timings["transfer"] = serde_json::json!(t_transfer);
+    }
+    let timings = timings.to_string();
     Ok(Refined {
         mesh,
         selection,
         steps,
         timings,
+        located,
+        point_fields,
+        cell_fields,
+        vertex_parents,
     })
 }
 

@@ -22,7 +22,7 @@ use pyo3::exceptions::{PyFileNotFoundError, PyOSError, PyRuntimeError, PyValueEr
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
-use core_api::{BuildNotes, TetMesh};
+use core_api::{BuildNotes, FieldIn, TetMesh, VertexParents};
 
 /// The unwinding payload of a cancelled run (Ctrl-C, or an exception raised
 /// by a progress callback). It is thrown with `resume_unwind`, which does not
@@ -127,6 +127,12 @@ pub struct Mesh {
     /// JSON wall times of refine()'s parts (empty for other meshes).
     timings: String,
     notes: BuildNotes,
+    /// Point fields (refine(): the input's, carried over).
+    point_fields: Vec<FieldIn>,
+    /// Cell fields, per tet.
+    cell_fields: Vec<FieldIn>,
+    /// The vertex parent map (refine() with fields or vertex_parents=True).
+    vertex_parents: Option<VertexParents>,
 }
 
 /// Where a refined mesh came from: what locating its parents needs.
@@ -154,6 +160,9 @@ impl Mesh {
             reports,
             timings,
             notes,
+            point_fields: Vec::new(),
+            cell_fields: Vec::new(),
+            vertex_parents: None,
         }
     }
 
@@ -183,6 +192,35 @@ impl Mesh {
         }
         Ok(self.located.get())
     }
+}
+
+/// Fields as a dict `{name: read-only array}`: `(n,)` for one component,
+/// `(n, k)` for more.
+fn fields_dict<'py>(py: Python<'py>, fields: &[FieldIn]) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    for f in fields {
+        let a = f.values.clone().into_pyarray(py);
+        let a = if f.components == 1 {
+            a.into_any()
+        } else {
+            a.reshape([f.values.len() / f.components, f.components])?
+                .into_any()
+        };
+        d.set_item(&f.name, readonly(a)?)?;
+    }
+    Ok(d)
+}
+
+/// Reads a `point_fields=` / `cell_fields=` argument.
+fn fields_arg(obj: &Bound<'_, PyAny>, arg: &str) -> PyResult<Vec<FieldIn>> {
+    Ok(arrays::fields(obj, arg)?
+        .into_iter()
+        .map(|(name, components, values)| FieldIn {
+            name,
+            components,
+            values,
+        })
+        .collect())
 }
 
 /// Reads the `mark` argument: a spec string or a list of them.
@@ -410,6 +448,51 @@ impl Mesh {
         readonly(core_api::corners(&self.inner).into_pyarray(py))
     }
 
+    /// dict name -> read-only array (n_points,) or (n_points, k): the point
+    /// fields refine() carried over (interpolated linearly in the input tet
+    /// holding each point; a point outside the input domain gets the value
+    /// at the nearest input boundary point). Empty for other meshes. A
+    /// further refine() carries them over again by default.
+    #[getter]
+    fn point_fields<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        fields_dict(py, &self.point_fields)
+    }
+
+    /// dict name -> read-only array (n_tets,) or (n_tets, k): the cell
+    /// fields refine() carried over (each tet has its parent's values).
+    /// Empty for other meshes.
+    #[getter]
+    fn cell_fields<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        fields_dict(py, &self.cell_fields)
+    }
+
+    /// The vertex parent map of a mesh refine() made with fields to carry
+    /// over or vertex_parents=True (else None): a dict of read-only arrays
+    /// per point, "tet" (n_points,) uint32, the input tet holding the point;
+    /// "vertices" (n_points, 4) uint32, that tet's vertices; "bary"
+    /// (n_points, 4) float64, the point's barycentric coordinates for them;
+    /// "outside" (n_points,) bool, the point lies outside the input (then
+    /// "bary" give the nearest input boundary point). The CLI's .vtu arrays
+    /// parent_tet, parent_vertices, parent_bary, parent_outside.
+    #[getter]
+    fn vertex_parents<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyDict>>> {
+        let Some(v) = &self.vertex_parents else {
+            return Ok(None);
+        };
+        let n = v.tet.len();
+        let d = PyDict::new(py);
+        d.set_item("tet", readonly(v.tet.clone().into_pyarray(py))?)?;
+        let verts: Vec<u32> = v.vertices.iter().flatten().copied().collect();
+        d.set_item(
+            "vertices",
+            readonly(verts.into_pyarray(py).reshape([n, 4])?)?,
+        )?;
+        let bary: Vec<f64> = v.bary.iter().flatten().copied().collect();
+        d.set_item("bary", readonly(bary.into_pyarray(py).reshape([n, 4])?)?)?;
+        d.set_item("outside", readonly(v.outside.clone().into_pyarray(py))?)?;
+        Ok(Some(d))
+    }
+
     /// The reports of the operation that made this mesh: for refine(), one
     /// dict per step (phases with tets and seconds, operation counts, the
     /// optimize report; with stats=True also "quality", the quality() dict
@@ -427,8 +510,10 @@ impl Mesh {
 
     /// For a mesh made by refine(): wall seconds of its parts — "copy" (of
     /// the input), "features" (detection), "steps" (the √3 steps, as the
-    /// library's step clocks count them), "compact". (Parents are located
-    /// later, on first use.) None for other meshes.
+    /// library's step clocks count them), "compact", and with fields to
+    /// carry over or vertex_parents=True "transfer" (parent and point
+    /// location, interpolation). (Otherwise parents are located later, on
+    /// first use.) None for other meshes.
     #[getter]
     fn timings<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyAny>>> {
         if self.timings.is_empty() {
@@ -521,7 +606,10 @@ impl Mesh {
     /// boundary-smooth and optimize (edge removal and smoothing).
     ///
     /// Options (the CLI flag in brackets):
-    ///   steps         Number of √3 steps [--steps] (default 1).
+    ///   steps         Number of √3 steps [--steps] (default 1); with a size
+    ///                 map, of size passes, or 'auto' (the default there):
+    ///                 passes until no edge is longer than its target, at
+    ///                 most 20.
     ///   boundary      Boundary rule: 'interpolating' (Labsik–Greiner),
     ///                 'approximating' (Kobbelt) or 'linear' [--boundary].
     ///   opt_passes    Passes of the optimize phase (edge removal +
@@ -570,24 +658,51 @@ impl Mesh {
     ///                 unrefined instead of raising ValueError [--allow-empty].
     ///   allow_steps_zero  steps=0 returns the mesh unrefined instead of
     ///                 raising ValueError [--allow-steps-zero].
+    ///   point_fields  Fields to carry over, a dict name -> array
+    ///                 (n_points,) or (n_points, k) [--fields]: each is
+    ///                 interpolated linearly in the input tet holding every
+    ///                 output point (a field linear in x, y, z comes back to
+    ///                 round-off; a point the boundary rule moved outside the
+    ///                 input gets the value at the nearest input boundary
+    ///                 point). Default: this mesh's own point_fields.
+    ///   cell_fields   Per-tet fields, a dict name -> array (n_tets,) or
+    ///                 (n_tets, k), copied from each new tet's parent
+    ///                 [--fields]. Default: this mesh's own cell_fields.
+    ///   transfer      Carry the fields over: None (default) when there are
+    ///                 any, True (an error without fields) [--transfer], or
+    ///                 False to drop them [--no-transfer]. The new mesh's
+    ///                 point_fields, cell_fields and vertex_parents hold the
+    ///                 result.
+    ///   vertex_parents  Compute the vertex parent map (the new mesh's
+    ///                 vertex_parents) even without fields [--parent-map].
+    ///   size          MMG size map, per point [--size] [--size-array]: an
+    ///                 array (n_points,) of target edge lengths, or
+    ///                 (n_points, 6) of metrics m11 m12 m22 m13 m23 m33
+    ///                 (MMG's order). Long edges are split, longest first,
+    ///                 pass after pass, until every edge is at most √2 × its
+    ///                 target (the √3 step is not used).
+    ///   hsiz          One target edge length everywhere [--hsiz].
+    ///   hmax          The largest target edge length: caps size or hsiz,
+    ///                 or alone is the size map [--hmax].
     ///
     /// The GIL is released while the mesh is refined. Ctrl-C (SIGINT) stops
     /// the run at the start of the next phase and raises KeyboardInterrupt.
     /// Bad options raise ValueError with the CLI's message; an unreadable
     /// features file raises OSError.
     #[pyo3(
-        signature = (steps=1, *, boundary="interpolating", opt_passes=3, threshold=0.3,
+        signature = (steps=None, *, boundary="interpolating", opt_passes=3, threshold=0.3,
                      stop_after=None, features=PathOrName("auto".into()), feature_angle=45.0, indicator=None,
                      mark=None, region=None, r#box=None, sphere=None, smooth="refined",
                      step_offset=0, progress=None, stats=false, allow_empty=false,
-                     allow_steps_zero=false),
-        text_signature = "(self, steps=1, *, boundary='interpolating', opt_passes=3, threshold=0.3, stop_after=None, features='auto', feature_angle=45.0, indicator=None, mark='doerfler:0.5', region=None, box=None, sphere=None, smooth='refined', step_offset=0, progress=False, stats=False, allow_empty=False, allow_steps_zero=False)"
+                     allow_steps_zero=false, point_fields=None, cell_fields=None,
+                     transfer=None, vertex_parents=false, size=None, hsiz=None, hmax=None),
+        text_signature = "(self, steps=None, *, boundary='interpolating', opt_passes=3, threshold=0.3, stop_after=None, features='auto', feature_angle=45.0, indicator=None, mark='doerfler:0.5', region=None, box=None, sphere=None, smooth='refined', step_offset=0, progress=False, stats=False, allow_empty=False, allow_steps_zero=False, point_fields=None, cell_fields=None, transfer=None, vertex_parents=False, size=None, hsiz=None, hmax=None)"
     )]
     #[allow(clippy::too_many_arguments)]
     fn refine(
         slf: &Bound<'_, Self>,
         py: Python<'_>,
-        steps: usize,
+        steps: Option<&Bound<'_, PyAny>>,
         boundary: &str,
         opt_passes: usize,
         threshold: f64,
@@ -605,7 +720,43 @@ impl Mesh {
         stats: bool,
         allow_empty: bool,
         allow_steps_zero: bool,
+        point_fields: Option<&Bound<'_, PyAny>>,
+        cell_fields: Option<&Bound<'_, PyAny>>,
+        transfer: Option<bool>,
+        vertex_parents: bool,
+        size: Option<&Bound<'_, PyAny>>,
+        hsiz: Option<f64>,
+        hmax: Option<f64>,
     ) -> PyResult<Mesh> {
+        let this = slf.get();
+        let size = match size {
+            Some(x) => Some(arrays::table(x, "size")?),
+            None => None,
+        };
+        let size_given = size.is_some() || hsiz.is_some() || hmax.is_some();
+        // steps: None (1, or 'auto' with a size map), an int, or 'auto'.
+        let (steps, steps_auto) = match steps {
+            None if size_given => (core_api::AUTO_SIZE_PASSES, true),
+            None => (1, false),
+            Some(s) if s.extract::<String>().is_ok_and(|t| t == "auto") => {
+                (core_api::AUTO_SIZE_PASSES, true)
+            }
+            Some(s) => (
+                s.extract::<usize>().map_err(|_| {
+                    PyValueError::new_err("steps must be a number of steps (>= 0) or 'auto'")
+                })?,
+                false,
+            ),
+        };
+        let point_fields = match point_fields {
+            Some(f) => fields_arg(f, "point_fields")?,
+            None => this.point_fields.clone(),
+        };
+        let cell_fields = match cell_fields {
+            Some(f) => fields_arg(f, "cell_fields")?,
+            None => this.cell_fields.clone(),
+        };
+        let has_fields = !point_fields.is_empty() || !cell_fields.is_empty();
         let smooth_refined = match smooth {
             "refined" => true,
             "all" => false,
@@ -647,6 +798,14 @@ impl Mesh {
             stats,
             allow_empty,
             allow_steps_zero,
+            steps_auto,
+            size,
+            hsiz,
+            hmax,
+            point_fields,
+            cell_fields,
+            transfer: transfer.unwrap_or(has_fields),
+            vertex_parents,
         };
         // progress: None/False, True (lines on stderr) or a callable.
         let (print, callback): (bool, Option<Py<PyAny>>) = match progress {
@@ -676,23 +835,29 @@ impl Mesh {
                 std::panic::resume_unwind(Box::new(Cancelled));
             }
         };
-        let this = slf.get();
         let mesh = &this.inner;
         let ind = values.as_deref();
         let result = run_core(py, Some(&cancelled), || {
             core_api::refine(mesh, &args, ind, &hook)
         })?;
         match result {
-            Ok(r) => Ok(Mesh::made(
-                r.mesh,
-                r.steps,
-                r.timings,
-                BuildNotes::default(),
-                Some(Lineage {
-                    input: slf.clone().unbind(),
-                    selection: r.selection.map(Arc::new),
-                }),
-            )),
+            Ok(r) => {
+                let lineage = match r.located {
+                    Some(_) => None,
+                    None => Some(Lineage {
+                        input: slf.clone().unbind(),
+                        selection: r.selection.map(Arc::new),
+                    }),
+                };
+                let mut m = Mesh::made(r.mesh, r.steps, r.timings, BuildNotes::default(), lineage);
+                if let Some(l) = r.located {
+                    let _ = m.located.set(l);
+                }
+                m.point_fields = r.point_fields;
+                m.cell_fields = r.cell_fields;
+                m.vertex_parents = r.vertex_parents;
+                Ok(m)
+            }
             Err(core_api::RefineError::Value(m)) => Err(PyValueError::new_err(m)),
             Err(core_api::RefineError::File(m)) => Err(PyOSError::new_err(m)),
         }

@@ -30,16 +30,6 @@ FILE_FLAGS = {
     # The memory guard is the CLI's (it estimates a process's peak from
     # /proc/meminfo); the package has none yet.
     "--max-memory": None,
-    # Field transfer and size maps (issue 17) are the CLI's only so far:
-    # the package has no point/cell fields on Mesh and no size-map argument
-    # yet. Listed here so that a new CLI flag still fails this test.
-    "--transfer": None,
-    "--no-transfer": None,
-    "--fields": None,
-    "--size": None,
-    "--size-array": None,
-    "--hsiz": None,
-    "--hmax": None,
 }
 
 
@@ -54,7 +44,7 @@ def test_refine_help_covers_every_cli_flag(cli):
             assert f"[{flag}]" in doc, f"help(Mesh.refine) does not mention {flag}"
     # It reads like --help: the usage line, a summary, one entry per option.
     assert str(inspect.signature(tetrefine.Mesh.refine)).startswith(
-        "(self, steps=1, *, boundary='interpolating'"
+        "(self, steps=None, *, boundary='interpolating'"
     )
     assert doc.startswith("Refine with the √3 tetrahedral subdivision")
     assert "Options (the CLI flag in brackets):" in doc

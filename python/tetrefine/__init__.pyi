@@ -60,6 +60,15 @@ class BuildNotes(TypedDict):
     dropped_triangles: int
     dropped_edges: int
 
+class VertexParents(TypedDict):
+    """Per output point: the input tet holding it, that tet's vertices, the
+    point's barycentric coordinates for them, and whether it lies outside."""
+
+    tet: npt.NDArray[np.uint32]
+    vertices: npt.NDArray[np.uint32]
+    bary: npt.NDArray[np.float64]
+    outside: npt.NDArray[np.bool_]
+
 Phase = Literal["split", "flip", "boundary-split", "boundary-flip", "boundary-smooth", "optimize"]
 
 class Mesh:
@@ -103,6 +112,15 @@ class Mesh:
     @property
     def corners(self) -> npt.NDArray[np.uint32]: ...
     @property
+    def point_fields(self) -> dict[str, npt.NDArray[np.float64]]:
+        """Point fields refine() carried over: (n_points,) or (n_points, k)."""
+    @property
+    def cell_fields(self) -> dict[str, npt.NDArray[np.float64]]:
+        """Cell fields refine() carried over (by parent): (n_tets,) or (n_tets, k)."""
+    @property
+    def vertex_parents(self) -> VertexParents | None:
+        """The vertex parent map of a refine() with fields or vertex_parents=True."""
+    @property
     def reports(self) -> list[dict[str, Any]]: ...
     @property
     def build_notes(self) -> BuildNotes: ...
@@ -113,7 +131,7 @@ class Mesh:
     def write(self, path: _Path) -> None: ...
     def refine(
         self,
-        steps: int = 1,
+        steps: int | Literal["auto"] | None = None,
         *,
         boundary: Literal["interpolating", "approximating", "linear"] = "interpolating",
         opt_passes: int = 3,
@@ -132,6 +150,13 @@ class Mesh:
         stats: bool = False,
         allow_empty: bool = False,
         allow_steps_zero: bool = False,
+        point_fields: dict[str, _Reals] | None = None,
+        cell_fields: dict[str, _Reals] | None = None,
+        transfer: bool | None = None,
+        vertex_parents: bool = False,
+        size: _Reals | None = None,
+        hsiz: float | None = None,
+        hmax: float | None = None,
     ) -> Mesh: ...
     def improve(self, opt_passes: int = 5, *, threshold: float = 0.3) -> Mesh: ...
     def bisect(self, steps: int = 1) -> Mesh: ...

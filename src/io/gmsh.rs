@@ -21,13 +21,30 @@
 //! lists an element once per physical group, has the copies merged by their
 //! nodes. Point elements' tags are kept by the coordinates of their node.
 //! `$NodeData` views become point fields (the last time step of each name;
-//! every node needs a finite value).
+//! every node needs a finite value). `$ElementData` views become cell fields
+//! the same way: every tetrahedron needs a finite value (an MSH 2.2 copy of
+//! a tet, one per physical group, the same values), an element tag the file
+//! does not define is an error at its line, and values at the other
+//! elements (boundary triangles, lines, points) are skipped, since they are
+//! no cells of the mesh — tetrefine's own writer and meshio's give every
+//! element a value. An `$ElementData` before `$Elements` is an error.
 //!
 //! The writer puts every stored value in its own entity with the physical
 //! tags behind it, every corner in a point entity (physical tag 1 when the
 //! input gave it none), writes the names of the groups that have entities,
-//! and point and cell fields of matching length as `$NodeData` and
-//! `$ElementData`, so that Gmsh and meshio read everything back.
+//! and point and cell fields of matching length (1 to 9 components) as
+//! `$NodeData` and `$ElementData`, so that Gmsh and meshio read everything
+//! back. `$ElementData` gives a value to every element of the file, with
+//! element tags 1, 2, … in file order (MSH 2.2: every copy of a tet too):
+//! the tets their field values, the boundary triangles, feature lines and
+//! corner points NaN ("no value"). meshio needs this: it reads the values
+//! in file order, splits them over all element blocks and checks that the
+//! binary tags are 1, 2, …, so values for the tets alone would land on the
+//! triangles. NaN, not a neighbouring tet's value, because a marked face
+//! between two regions has two neighbours with different values, and
+//! because a statistic over all cells (ParaView's range, `numpy.nanmean`)
+//! then sees the tets' values only; it is what `Mesh.to_meshio` of the
+//! Python package puts on triangles too.
 
 use super::meta::{assign_values, Field, MeshMeta};
 use super::{drop_unused_points, read_bytes, write_atomic, IoError};
@@ -410,6 +427,27 @@ struct NodeView {
     line: usize,
 }
 
+/// An `$ElementData` view as read: its values at the tetrahedra (NaN where
+/// the view gave none), which tets it covered, and the line of its header.
+struct ElementView {
+    name: String,
+    components: usize,
+    values: Vec<f64>,
+    have: Vec<bool>,
+    line: usize,
+}
+
+/// What an element tag of `$Elements` stands for, for `$ElementData`.
+#[derive(Clone, Copy)]
+enum ElemSlot {
+    /// The tetrahedron of this index (an MSH 2.2 copy of it, one per
+    /// physical group, too).
+    Tet(u32),
+    /// An element that is not a tetrahedron (a triangle, line, point or
+    /// skipped element): its values are not a cell field of the mesh.
+    Other,
+}
+
 /// Collects the elements of a file into [`MeshData`] and [`MeshMeta`].
 struct Collector {
     data: MeshData,
@@ -435,6 +473,17 @@ struct Collector {
     /// `$PhysicalNames` entries with their lines.
     names: Vec<(i32, i32, String, usize)>,
     views: Vec<NodeView>,
+    /// The element tag of each tet (its first copy in MSH 2.2).
+    tet_elems: Vec<u64>,
+    /// MSH 2.2 copies of a tet: (element tag, tet index).
+    copy_elems: Vec<(u64, u32)>,
+    /// The element tags of the elements that are not tets.
+    other_elems: Vec<u64>,
+    /// Whether an `$Elements` section was read.
+    have_elements: bool,
+    /// Element tag → slot, built at the first `$ElementData`.
+    elem_index: Option<HashMap<u64, ElemSlot>>,
+    element_views: Vec<ElementView>,
 }
 
 /// The index of an earlier element with the vertex set `key` (sorted), or
@@ -474,7 +523,32 @@ impl Collector {
             physicals: Default::default(),
             names: Vec::new(),
             views: Vec::new(),
+            tet_elems: Vec::new(),
+            copy_elems: Vec::new(),
+            other_elems: Vec::new(),
+            have_elements: false,
+            elem_index: None,
+            element_views: Vec::new(),
         }
+    }
+
+    /// The slot of every element tag of `$Elements` (built once).
+    fn element_index(&mut self) -> &HashMap<u64, ElemSlot> {
+        self.elem_index.get_or_insert_with(|| {
+            let mut m = HashMap::with_capacity(
+                self.tet_elems.len() + self.copy_elems.len() + self.other_elems.len(),
+            );
+            for &t in &self.other_elems {
+                m.insert(t, ElemSlot::Other);
+            }
+            for (i, &t) in self.tet_elems.iter().enumerate() {
+                m.insert(t, ElemSlot::Tet(i as u32));
+            }
+            for &(t, i) in &self.copy_elems {
+                m.insert(t, ElemSlot::Tet(i));
+            }
+            m
+        })
     }
 
     /// The tag of an element with these physical tags (none: `entity`).
@@ -533,8 +607,12 @@ impl Collector {
         Ok(())
     }
 
-    /// Adds the element whose nodes are in `node_buf`.
-    fn add(&mut self, role: Role, etype: i64, tag: ElemTag, line: Option<usize>) {
+    /// Adds the element whose nodes are in `node_buf`; `elem` is its
+    /// element tag (for `$ElementData`).
+    fn add(&mut self, role: Role, etype: i64, tag: ElemTag, line: Option<usize>, elem: u64) {
+        if role != Role::Tet {
+            self.other_elems.push(elem);
+        }
         let n = self.node_buf.clone();
         if matches!(etype, 8 | 9 | 11) {
             self.quadratic = true;
@@ -551,10 +629,13 @@ impl Collector {
                     .then(|| seen_before(&mut self.seen_tets, sorted(v), self.data.tets.len()))
                     .flatten();
                 if self.absorb(role, seen, tag) {
+                    let j = seen.expect("absorbed into an earlier tet");
+                    self.copy_elems.push((elem, j as u32));
                     return;
                 }
                 self.data.tets.push(v);
                 self.tet_tags.push(tag);
+                self.tet_elems.push(elem);
                 if let Some(l) = line {
                     self.data.tet_lines.push(l as u32);
                 }
@@ -770,6 +851,37 @@ impl Collector {
                 values,
             });
         }
+        // Element views likewise: the last one of each name covers every tet.
+        let mut by_name: BTreeMap<String, usize> = BTreeMap::new();
+        for (i, v) in self.element_views.iter().enumerate() {
+            by_name.insert(v.name.clone(), i);
+        }
+        let mut keep: Vec<usize> = by_name.into_values().collect();
+        keep.sort_unstable();
+        let nt = self.data.tets.len();
+        for i in keep {
+            let v = &mut self.element_views[i];
+            let missing = v.have.iter().filter(|&&h| !h).count();
+            if missing > 0 || v.have.len() != nt {
+                let first = v.have.iter().position(|&h| !h).unwrap_or(v.have.len());
+                let tag = self.tet_elems.get(first).copied().unwrap_or(0);
+                return Err(IoError::at(
+                    path,
+                    v.line,
+                    format!(
+                        "$ElementData \"{}\" has values for {} of the {nt} tetrahedra ({} missing, the first element {tag}): a cell field must cover every tetrahedron",
+                        v.name,
+                        v.have.len() - missing,
+                        missing + nt.saturating_sub(v.have.len()),
+                    ),
+                ));
+            }
+            meta.cell_fields.push(Field {
+                name: std::mem::take(&mut v.name),
+                components: v.components,
+                values: std::mem::take(&mut v.values),
+            });
+        }
         if self.quadratic {
             let before = self.data.points.clone();
             drop_unused_points(&mut self.data);
@@ -855,6 +967,7 @@ pub fn read_with_meta(path: &Path) -> Result<(MeshData, MeshMeta), IoError> {
         match section {
             "$PhysicalNames" => read_physical_names(&mut c, &mut col)?,
             "$NodeData" => read_node_data(&mut c, &mut col)?,
+            "$ElementData" => read_element_data(&mut c, &mut col)?,
             "$Nodes" if v2 => read_nodes_v2(&mut c, &mut col)?,
             "$Elements" if v2 => read_elements_v2(&mut c, &mut col)?,
             "$Entities" if !v2 => read_entities_v41(&mut c, &mut col, &mut physical)?,
@@ -940,10 +1053,17 @@ fn read_physical_names(c: &mut Cursor, col: &mut Collector) -> Result<(), IoErro
     Ok(())
 }
 
-/// `$NodeData`: a view's string, real and integer tags in ASCII, then one
-/// node tag and `components` doubles per entry (binary in binary files, with
-/// an `int` tag in MSH 2.2 and 4.1 alike, as Gmsh 4.15 writes them).
-fn read_node_data(c: &mut Cursor, col: &mut Collector) -> Result<(), IoError> {
+/// The header of a `$NodeData` / `$ElementData` view (`section` without
+/// the `$`), in ASCII in every variant: the string tags (the first is the
+/// name), the real tags (the time), the integer tags (time step,
+/// components, entries). Returns the name, the components, the entry count
+/// and the line of the entry count; the cursor is then before the entries
+/// (past the line end in binary files).
+fn data_header(
+    c: &mut Cursor,
+    section: &str,
+    per: &str,
+) -> Result<(String, usize, usize, usize), IoError> {
     let binary = c.binary;
     c.binary = false;
     let ns = c.count("the string tag count", 2)?;
@@ -972,40 +1092,52 @@ fn read_node_data(c: &mut Cursor, col: &mut Collector) -> Result<(), IoError> {
     let (components, n) = match ints.as_slice() {
         [_, comp, n, ..] => (*comp, *n),
         _ => {
-            return Err(
-                c.error("$NodeData needs three integer tags (time step, components, entries)")
-            )
+            return Err(c.error(format!(
+                "${section} needs three integer tags (time step, components, entries)"
+            )))
         }
     };
     if !(1..=9).contains(&components) {
         return Err(c.error(format!(
-            "$NodeData \"{name}\": {components} components per node is not valid (1 to 9)"
+            "${section} \"{name}\": {components} components per {per} is not valid (1 to 9)"
         )));
     }
     let components = components as usize;
     let left = (c.b.len() - c.pos) as i64;
     if n < 0 || n > left / (2 * components as i64 + 2) + 1 {
-        return Err(c.error(format!(
-            "$NodeData \"{name}\": {n} entries is more than the rest of the file can hold"
-        )));
+        let message = format!(
+            "${section} \"{name}\": {n} entries is more than the rest of the file can hold (truncated?)"
+        );
+        // The header is ASCII: name the line of the entry count.
+        return Err(IoError::at(c.path, line, message));
     }
     c.binary = binary;
     if binary {
         c.line_end()?;
     }
-    let mut tags = Vec::with_capacity(n as usize);
-    let mut values = Vec::with_capacity(n as usize * components);
+    Ok((name, components, n as usize, line))
+}
+
+/// The node or element tag of one entry of a view: an `int` in binary
+/// files (MSH 2.2 and 4.1 alike, as Gmsh 4.15 writes them), a number in
+/// ASCII.
+fn entry_tag(c: &mut Cursor, what: &str) -> Result<u64, IoError> {
+    if c.binary {
+        let t = c.int(what)?;
+        Ok(u64::try_from(t).unwrap_or(u64::MAX))
+    } else {
+        c.parse::<u64>(what)
+    }
+}
+
+/// `$NodeData`: a view's header ([`data_header`]), then one node tag and
+/// `components` doubles per entry.
+fn read_node_data(c: &mut Cursor, col: &mut Collector) -> Result<(), IoError> {
+    let (name, components, n, line) = data_header(c, "NodeData", "node")?;
+    let mut tags = Vec::with_capacity(n);
+    let mut values = Vec::with_capacity(n * components);
     for _ in 0..n {
-        let tag = if binary {
-            let t = c.int("a node tag")?;
-            if t < 0 {
-                u64::MAX
-            } else {
-                t as u64
-            }
-        } else {
-            c.parse::<u64>("a node tag")?
-        };
+        let tag = entry_tag(c, "a node tag")?;
         tags.push(tag);
         for _ in 0..components {
             let x = c.double("a field value")?;
@@ -1023,6 +1155,65 @@ fn read_node_data(c: &mut Cursor, col: &mut Collector) -> Result<(), IoError> {
         components,
         tags,
         values,
+        line,
+    });
+    Ok(())
+}
+
+/// `$ElementData`: a view's header ([`data_header`]), then one element tag
+/// and `components` doubles per entry. Values at tetrahedra become a cell
+/// field (they must be finite; an MSH 2.2 copy of a tet, one per physical
+/// group, must repeat its values); values at other elements (boundary
+/// triangles, lines, points: not cells of the mesh, whatever they hold —
+/// tetrefine's and meshio's writers give every element a value) are
+/// skipped. An element tag `$Elements` does not define is an error at its
+/// line.
+fn read_element_data(c: &mut Cursor, col: &mut Collector) -> Result<(), IoError> {
+    if !col.have_elements {
+        return Err(c.error(
+            "$ElementData comes before $Elements (its element tags name elements of the file)",
+        ));
+    }
+    let (name, components, n, line) = data_header(c, "ElementData", "element")?;
+    let nt = col.data.tets.len();
+    let mut values = vec![f64::NAN; nt * components];
+    let mut have = vec![false; nt];
+    let mut entry = vec![0.0; components];
+    for _ in 0..n {
+        let tag = entry_tag(c, "an element tag")?;
+        let slot = col.element_index().get(&tag).copied();
+        let Some(slot) = slot else {
+            return Err(c.error(format!(
+                "$ElementData \"{name}\" refers to element {tag}, which is not defined in $Elements"
+            )));
+        };
+        for x in entry.iter_mut() {
+            *x = c.double("a field value")?;
+        }
+        let ElemSlot::Tet(t) = slot else {
+            continue;
+        };
+        if let Some(x) = entry.iter().find(|x| !x.is_finite()) {
+            return Err(c.error(format!(
+                "$ElementData \"{name}\": value {x} at element {tag} (a tetrahedron) is not a finite number"
+            )));
+        }
+        let t = t as usize;
+        let slot = &mut values[t * components..(t + 1) * components];
+        if have[t] && slot != entry.as_slice() {
+            return Err(c.error(format!(
+                "$ElementData \"{name}\": element {tag} is given {entry:?}, but the same tetrahedron (another copy of it, or the same tag) was given {slot:?}"
+            )));
+        }
+        slot.copy_from_slice(&entry);
+        have[t] = true;
+    }
+    end_section(c, "$EndElementData")?;
+    col.element_views.push(ElementView {
+        name,
+        components,
+        values,
+        have,
         line,
     });
     Ok(())
@@ -1051,6 +1242,12 @@ fn read_nodes_v2(c: &mut Cursor, col: &mut Collector) -> Result<(), IoError> {
     }
     end_section(c, "$EndNodes")?;
     col.set_nodes(c, &tags, coords)
+}
+
+/// An MSH 2.2 element number as a tag (a negative one, which no
+/// `$ElementData` can name, becomes `u64::MAX`).
+fn elem_tag(num: i64) -> u64 {
+    u64::try_from(num).unwrap_or(u64::MAX)
 }
 
 /// An `i64` tag as the `i32` the mesh stores.
@@ -1123,7 +1320,7 @@ fn read_elements_v2(c: &mut Cursor, col: &mut Collector) -> Result<(), IoError> 
                 .ok_or_else(|| c.error(format!("unknown element type {etype}")))?;
             let role = role_of_type(etype);
             for _ in 0..count {
-                let _num = c.int("an element number")?;
+                let num = c.int("an element number")?;
                 tags.clear();
                 for _ in 0..ntags {
                     tags.push(c.int("an element tag")?);
@@ -1133,13 +1330,13 @@ fn read_elements_v2(c: &mut Cursor, col: &mut Collector) -> Result<(), IoError> 
                     Ok(if t < 0 { u64::MAX } else { t as u64 })
                 })?;
                 let tag = tag_v2(c, col, etype, &tags)?;
-                col.add(role, etype, tag, None);
+                col.add(role, etype, tag, None, elem_tag(num));
             }
             done += count as usize;
         }
     } else {
         for _ in 0..n {
-            let _num: i64 = c.parse("an element number")?;
+            let num: i64 = c.parse("an element number")?;
             let line = c.last_line;
             let etype: i64 = c.parse("an element type")?;
             let ntags = c.count("a tag count", 2)?;
@@ -1150,6 +1347,7 @@ fn read_elements_v2(c: &mut Cursor, col: &mut Collector) -> Result<(), IoError> 
             let role = role_of_type(etype);
             if role == Role::Skip {
                 tag_v2(c, col, etype, &tags)?;
+                col.other_elems.push(elem_tag(num));
                 c.skip_line();
                 continue;
             }
@@ -1166,9 +1364,10 @@ fn read_elements_v2(c: &mut Cursor, col: &mut Collector) -> Result<(), IoError> 
                 )));
             }
             let tag = tag_v2(c, col, etype, &tags)?;
-            col.add(role, etype, tag, Some(line));
+            col.add(role, etype, tag, Some(line), elem_tag(num));
         }
     }
+    col.have_elements = true;
     end_section(c, "$EndElements")
 }
 
@@ -1332,9 +1531,10 @@ fn read_elements_v41(
             continue;
         };
         for _ in 0..k {
-            let _etag = c.size("an element tag")?;
+            let etag = c.size("an element tag")?;
             let line = c.last_line;
             if role == Role::Skip {
+                col.other_elems.push(etag);
                 for _ in 0..nodes {
                     c.size("a node tag")?;
                 }
@@ -1352,7 +1552,7 @@ fn read_elements_v41(
                 )));
             }
             let l = (!c.binary).then_some(line);
-            col.add(role, etype, tag_value, l);
+            col.add(role, etype, tag_value, l, etag);
         }
     }
     if total != n {
@@ -1362,6 +1562,7 @@ fn read_elements_v41(
             format!("element blocks hold {total} elements but the header announced {n}"),
         ));
     }
+    col.have_elements = true;
     end_section(c, "$EndElements")
 }
 
@@ -1423,6 +1624,10 @@ pub fn write_with(
 /// tag: corners have no marker of their own, but meshio needs every entity
 /// to have a physical tag once any has one.
 const CORNER_PHYSICAL: i32 = 1;
+
+/// An element of the written file that is not a tet (see `elem_tet` in
+/// [`write_data_with`]).
+const NO_TET: u32 = u32::MAX;
 
 /// One entity of the written file: its physical tags and the elements in it.
 struct Entity<E> {
@@ -1547,6 +1752,12 @@ pub fn write_data_with(
         meta,
         d.tets.iter().enumerate().map(|(t, v)| (*v, d.region(t))),
     );
+    // The tets of each volume entity, in the order `group` lists them.
+    let mut volume_tets: BTreeMap<i32, Vec<u32>> = BTreeMap::new();
+    for t in 0..d.tets.len() {
+        volume_tets.entry(d.region(t)).or_default().push(t as u32);
+    }
+    let volume_tets: Vec<Vec<u32>> = volume_tets.into_values().collect();
     let surfaces = group(2, meta, d.triangles.iter().copied());
     let curves = group(1, meta, d.edges.iter().copied());
     let mut corner_ids = d.corners.clone();
@@ -1586,11 +1797,13 @@ pub fn write_data_with(
         .point_fields
         .iter()
         .filter(|f| f.len() == np && f.values.len() == np * f.components)
+        .filter(|f| (1..=9).contains(&f.components))
         .collect();
     let cell_fields: Vec<&Field> = meta
         .cell_fields
         .iter()
         .filter(|f| f.len() == nt && f.values.len() == nt * f.components)
+        .filter(|f| (1..=9).contains(&f.components))
         .collect();
     write_atomic(path, |w| {
         match format {
@@ -1609,8 +1822,9 @@ pub fn write_data_with(
             }
             writeln!(w, "$EndPhysicalNames")?;
         }
-        // Element tag of each tet (for $ElementData), in mesh order.
-        let mut tet_tag = vec![0u64; nt];
+        // Per element of the file, in element-tag order (tags 1, 2, …): the
+        // tet it is, or NO_TET (for $ElementData).
+        let mut elem_tet: Vec<u32> = Vec::new();
         if format == MshFormat::V22 {
             writeln!(w, "$Nodes\n{np}")?;
             for (i, p) in d.points.iter().enumerate() {
@@ -1629,7 +1843,7 @@ pub fn write_data_with(
                 for v in nodes {
                     write!(w, " {}", v + 1)?;
                 }
-                writeln!(w).map(|_| num)
+                writeln!(w)
             };
             for (i, e) in corners.iter().enumerate() {
                 for &p in &e.physical {
@@ -1650,23 +1864,23 @@ pub fn write_data_with(
                     }
                 }
             }
-            let mut tet_of: HashMap<[u32; 4], usize> = HashMap::new();
-            if !cell_fields.is_empty() {
-                tet_of = d.tets.iter().enumerate().map(|(t, v)| (*v, t)).collect();
-            }
             for (i, e) in volumes.iter().enumerate() {
-                for (k, &p) in e.physical.iter().enumerate() {
+                for &p in &e.physical {
                     for v in &e.elements {
-                        let num = line(w, 4, p, i + 1, v)?;
-                        if k == 0 {
-                            if let Some(&t) = tet_of.get(v) {
-                                tet_tag[t] = num as u64;
-                            }
-                        }
+                        line(w, 4, p, i + 1, v)?;
                     }
                 }
             }
             writeln!(w, "$EndElements")?;
+            if !cell_fields.is_empty() {
+                // Every copy of a tet (one per physical group) has its values.
+                elem_tet = vec![NO_TET; n - count(&volumes)];
+                for (e, ts) in volumes.iter().zip(&volume_tets) {
+                    for _ in &e.physical {
+                        elem_tet.extend_from_slice(ts);
+                    }
+                }
+            }
         } else {
             let binary = format == MshFormat::V41Binary;
             let mut e = Emit {
@@ -1753,8 +1967,7 @@ pub fn write_data_with(
                              ent: usize,
                              etype: i64,
                              elements: &mut dyn Iterator<Item = &[u32]>,
-                             count: usize,
-                             tags_out: &mut Vec<u64>|
+                             count: usize|
              -> std::io::Result<()> {
                 e.int(dim)?;
                 e.int(ent as i64)?;
@@ -1763,7 +1976,6 @@ pub fn write_data_with(
                 e.nl()?;
                 for nodes in elements {
                     tag += 1;
-                    tags_out.push(tag);
                     e.size(tag)?;
                     for &v in nodes {
                         e.size(u64::from(v) + 1)?;
@@ -1772,7 +1984,6 @@ pub fn write_data_with(
                 }
                 Ok(())
             };
-            let mut sink = Vec::new();
             for (i, c) in corners.iter().enumerate() {
                 block(
                     &mut e,
@@ -1781,7 +1992,6 @@ pub fn write_data_with(
                     15,
                     &mut std::iter::once(&c.elements[..]),
                     1,
-                    &mut sink,
                 )?;
             }
             for (i, c) in curves.iter().enumerate() {
@@ -1793,7 +2003,6 @@ pub fn write_data_with(
                     1,
                     &mut c.elements.iter().map(|x| &x[..]),
                     n,
-                    &mut sink,
                 )?;
             }
             for (i, c) in surfaces.iter().enumerate() {
@@ -1805,10 +2014,8 @@ pub fn write_data_with(
                     2,
                     &mut c.elements.iter().map(|x| &x[..]),
                     n,
-                    &mut sink,
                 )?;
             }
-            let mut vol_tags: Vec<u64> = Vec::with_capacity(nt);
             for (i, c) in volumes.iter().enumerate() {
                 let n = c.elements.len();
                 block(
@@ -1818,26 +2025,25 @@ pub fn write_data_with(
                     4,
                     &mut c.elements.iter().map(|x| &x[..]),
                     n,
-                    &mut vol_tags,
                 )?;
             }
             e.end()?;
             writeln!(e.w, "$EndElements")?;
             if !cell_fields.is_empty() {
-                // Volumes list the tets grouped by region, in mesh order within each.
-                let mut order: Vec<usize> = (0..nt).collect();
-                order.sort_by_key(|&t| d.region(t));
-                for (k, &t) in order.iter().enumerate() {
-                    tet_tag[t] = vol_tags[k];
+                // Element tags run 1, 2, … in block order, the volumes last.
+                elem_tet = vec![NO_TET; n_elements - nt];
+                for ts in &volume_tets {
+                    elem_tet.extend_from_slice(ts);
                 }
             }
         }
         let binary = format == MshFormat::V41Binary;
+        let nan = [f64::NAN; 9];
         let data_block = |w: &mut dyn Write,
                           section: &str,
                           f: &Field,
                           n: usize,
-                          tag_of: &dyn Fn(usize) -> u64|
+                          entry: &dyn Fn(usize) -> Option<usize>|
          -> std::io::Result<()> {
             writeln!(
                 w,
@@ -1846,14 +2052,20 @@ pub fn write_data_with(
                 f.components
             )?;
             for i in 0..n {
+                let values = match entry(i) {
+                    Some(k) => f.entry(k),
+                    None => &nan[..f.components],
+                };
+                // Tags 1..=n in order: meshio reads the values in file order
+                // and checks that the binary tags are 1, 2, ….
                 if binary {
-                    w.write_all(&(tag_of(i) as i32).to_le_bytes())?;
-                    for x in f.entry(i) {
+                    w.write_all(&(i as i32 + 1).to_le_bytes())?;
+                    for x in values {
                         w.write_all(&x.to_le_bytes())?;
                     }
                 } else {
-                    write!(w, "{}", tag_of(i))?;
-                    for x in f.entry(i) {
+                    write!(w, "{}", i + 1)?;
+                    for x in values {
                         write!(w, " {x:?}")?;
                     }
                     writeln!(w)?;
@@ -1865,10 +2077,12 @@ pub fn write_data_with(
             writeln!(w, "$End{section}")
         };
         for f in &point_fields {
-            data_block(w, "NodeData", f, np, &|i| i as u64 + 1)?;
+            data_block(w, "NodeData", f, np, &|i| Some(i))?;
         }
         for f in &cell_fields {
-            data_block(w, "ElementData", f, nt, &|i| tet_tag[i])?;
+            data_block(w, "ElementData", f, elem_tet.len(), &|i| {
+                (elem_tet[i] != NO_TET).then(|| elem_tet[i] as usize)
+            })?;
         }
         Ok(())
     })

@@ -34,6 +34,10 @@ use glam::{DMat3, DVec3};
 /// every edge of the result is at most `√2 ≈ 1.41` times its target.
 pub const SPLIT_ABOVE: f64 = std::f64::consts::SQRT_2;
 
+/// Size passes a loop "until every edge meets the map" runs at most (the
+/// CLI's `--steps auto`, the Python package's `steps="auto"`).
+pub const AUTO_SIZE_PASSES: usize = 20;
+
 /// A size map over the points of a mesh.
 #[derive(Clone, Debug, PartialEq)]
 pub enum SizeMap {
@@ -44,6 +48,45 @@ pub enum SizeMap {
 }
 
 impl SizeMap {
+    /// A size map from `components` values per point, point after point:
+    /// 1 (a target edge length, positive and finite) or 6 (a metric
+    /// `m11 m12 m22 m13 m23 m33`, positive definite). The error names the
+    /// first bad point (1-based, as mesh files count) and its value.
+    pub fn from_values(components: usize, values: &[f64]) -> Result<SizeMap, String> {
+        if components != 1 && components != 6 {
+            return Err(format!(
+                "{components} components; a size is 1 (length) or 6 (metric m11 m12 m22 m13 m23 m33)"
+            ));
+        }
+        if values.len() % components != 0 {
+            return Err(format!(
+                "{} values are no whole number of {components}-component entries",
+                values.len()
+            ));
+        }
+        for (k, e) in values.chunks_exact(components).enumerate() {
+            let ok = match e {
+                [h] => *h > 0.0 && h.is_finite(),
+                _ => is_positive_definite(&[e[0], e[1], e[2], e[3], e[4], e[5]]),
+            };
+            if !ok {
+                return Err(format!(
+                    "the value of point {} ({e:?}) is not a positive size or a positive-definite metric",
+                    k + 1
+                ));
+            }
+        }
+        Ok(match components {
+            1 => SizeMap::Iso(values.to_vec()),
+            _ => SizeMap::Aniso(
+                values
+                    .chunks_exact(6)
+                    .map(|c| [c[0], c[1], c[2], c[3], c[4], c[5]])
+                    .collect(),
+            ),
+        })
+    }
+
     /// Number of points the map covers.
     pub fn len(&self) -> usize {
         match self {

@@ -7,7 +7,9 @@ entities in several groups at once and names with blanks:
   bottom, also in 6 "ground"), the interface in 7 "interface";
 - curves: the 12 edges of box 2 in 3 "box 2 edges"; points: its corners in 2.
 
-and a point field "temperature" = 1 + 2x - 3y + 0.5z ($NodeData). Written as
+a point field "temperature" = 1 + 2x - 3y + 0.5z ($NodeData), and two cell
+fields on the tets ($ElementData): "density" = 7.85 in box 1 and 8.96 in box 2,
+and "centroid" = the tet's centroid (3 components). Written as
 MSH 2.2 ASCII (Gmsh writes an element once per physical group), MSH 4.1
 ASCII and MSH 4.1 binary. Usage: python3 make_gmsh_tagged.py [OUTDIR]
 """
@@ -51,10 +53,27 @@ tags, coords, _ = gmsh.model.mesh.getNodes()
 view = gmsh.view.add("temperature")
 data = [[1 + 2 * coords[3 * i] - 3 * coords[3 * i + 1] + 0.5 * coords[3 * i + 2]] for i in range(len(tags))]
 gmsh.view.addModelData(view, 0, "tagged", "NodeData", list(tags), data)
+xyz = {int(t): coords[3 * i : 3 * i + 3] for i, t in enumerate(tags)}
+tet_tags, density, centroid = [], [], []
+for vol, rho in [(v1, 7.85), (v2, 8.96)]:
+    types, etags, enodes = gmsh.model.mesh.getElements(3, vol)
+    for etype, et, en in zip(types, etags, enodes):
+        assert etype == 4, etype
+        for k, t in enumerate(et):
+            corners = [xyz[int(n)] for n in en[4 * k : 4 * k + 4]]
+            tet_tags.append(int(t))
+            density.append([rho])
+            centroid.append([sum(c[a] for c in corners) / 4 for a in range(3)])
+cells = []
+for name, values in [("density", density), ("centroid", centroid)]:
+    v = gmsh.view.add(name)
+    gmsh.view.addModelData(v, 0, "tagged", "ElementData", tet_tags, values)
+    cells.append(v)
 for version, binary, name in [(2.2, 0, "gmsh_tagged_v22.msh"), (4.1, 0, "gmsh_tagged_v41.msh"), (4.1, 1, "gmsh_tagged_v41_binary.msh")]:
     gmsh.option.setNumber("Mesh.MshFileVersion", version)
     gmsh.option.setNumber("Mesh.Binary", binary)
     path = os.path.join(out, name)
     gmsh.write(path)
-    gmsh.view.write(view, path, append=True)
+    for v in [view] + cells:
+        gmsh.view.write(v, path, append=True)
 gmsh.finalize()

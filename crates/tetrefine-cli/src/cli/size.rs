@@ -16,7 +16,7 @@ pub enum Steps {
 }
 
 /// Size passes `--steps auto` runs at most.
-pub const AUTO_CAP: usize = 20;
+pub const AUTO_CAP: usize = tetrefine::AUTO_SIZE_PASSES;
 
 impl std::str::FromStr for Steps {
     type Err = String;
@@ -78,27 +78,10 @@ pub fn size_map(
                     names.join(", ")
                 )
             })?;
-        if f.components != 1 && f.components != 6 {
-            return Err(format!(
-                "--size-array {name}: {} components; a size is 1 (length) or 6 (metric m11 m12 m22 m13 m23 m33)",
-                f.components
-            ));
-        }
-        for k in 0..f.len() {
-            let e = f.entry(k);
-            let ok = if f.components == 1 {
-                e[0] > 0.0 && e[0].is_finite()
-            } else {
-                tetrefine::is_positive_definite(&[e[0], e[1], e[2], e[3], e[4], e[5]])
-            };
-            if !ok {
-                return Err(format!(
-                    "--size-array {name}: the value of point {} ({e:?}) is not a positive size or a positive-definite metric",
-                    k + 1
-                ));
-            }
-        }
-        Some(from(f.components, f.values.clone()))
+        Some(
+            SizeMap::from_values(f.components, &f.values)
+                .map_err(|e| format!("--size-array {name}: {e}"))?,
+        )
     } else {
         hsiz.map(|h| SizeMap::Iso(vec![h; n]))
     };

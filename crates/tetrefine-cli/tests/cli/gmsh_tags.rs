@@ -292,3 +292,212 @@ fn a_name_for_an_unknown_tag_or_a_bad_field_is_an_error_at_its_line_and_nothing_
         assert!(!out.exists(), "nothing is written");
     }
 }
+
+/// The centroid of tet `t` of `d`.
+fn centroid(d: &MeshData, t: usize) -> [f64; 3] {
+    let mut c = [0.0; 3];
+    for &v in &d.tets[t] {
+        for (a, x) in c.iter_mut().zip(d.points[v as usize]) {
+            *a += x / 4.0;
+        }
+    }
+    c
+}
+
+/// The cell field `name` of `meta`.
+fn cell_field<'a>(meta: &'a MeshMeta, name: &str, what: &str) -> &'a tetrefine::io::Field {
+    meta.cell_fields
+        .iter()
+        .find(|f| f.name == name)
+        .unwrap_or_else(|| panic!("{what}: no cell field {name}: {:?}", meta.cell_fields))
+}
+
+/// Gmsh's density view: 7.85 in box 1 (x < 1), 8.96 in box 2.
+fn density_at(c: [f64; 3]) -> f64 {
+    if c[0] < 1.0 {
+        7.85
+    } else {
+        8.96
+    }
+}
+
+#[test]
+fn gmsh_element_data_is_read_in_every_layout_and_carried_over_by_parent() {
+    // The views Gmsh wrote (tests/data/make_gmsh_tagged.py): "density" by
+    // box, "centroid" = each tet's centroid; the values are checked against
+    // the geometry of the tets they land on, so a value on the wrong tet shows.
+    let mut centroids = Vec::new();
+    for f in [
+        "gmsh_tagged_v22.msh",
+        "gmsh_tagged_v41.msh",
+        "gmsh_tagged_v41_binary.msh",
+    ] {
+        let (d, meta) = read_mesh_with_meta(&data(f)).unwrap();
+        assert_eq!(d.tets.len(), 1455, "{f}");
+        assert_eq!(meta.cell_fields.len(), 2, "{f}");
+        let rho = cell_field(&meta, "density", f);
+        let cen = cell_field(&meta, "centroid", f);
+        assert_eq!((rho.components, rho.len()), (1, 1455), "{f}");
+        assert_eq!((cen.components, cen.len()), (3, 1455), "{f}");
+        for t in 0..d.tets.len() {
+            let c = centroid(&d, t);
+            assert_eq!(rho.values[t], density_at(c), "{f}: tet {t}");
+            for (x, y) in cen.entry(t).iter().zip(c) {
+                assert!((x - y).abs() <= 1e-12, "{f}: tet {t}");
+            }
+        }
+        centroids = (0..d.tets.len()).map(|t| centroid(&d, t)).collect();
+    }
+    // Through refine, in every MSH variant and as .vtu: every child has its
+    // parent's values (density by the box it lies in; a centroid of an
+    // input tet), read back by tetrefine's readers (meshio and Gmsh read
+    // them in python/tests/test_meshio.py and tests/gmsh_roundtrip.py).
+    let dir = tempfile::tempdir().unwrap();
+    let input = data("gmsh_tagged_v22.msh").to_string_lossy().into_owned();
+    for (out, format) in [
+        ("o22.msh", "2.2"),
+        ("o41.msh", "4.1"),
+        ("o41b.msh", "4.1-binary"),
+        ("o.vtu", "4.1"),
+    ] {
+        let out = dir.path().join(out);
+        let o = tetrefine(&[
+            "refine",
+            &input,
+            "-o",
+            out.to_str().unwrap(),
+            "--msh-format",
+            format,
+        ]);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(o.status.success(), "{err}");
+        assert!(err.contains("transfer: 1 point and 2 cell fields"), "{err}");
+        let (d, meta) = read_mesh_with_meta(&out).unwrap();
+        let what = format!("{}", out.display());
+        assert!(d.tets.len() > 1455 * 6, "{what}");
+        let rho = cell_field(&meta, "density", &what);
+        let cen = cell_field(&meta, "centroid", &what);
+        assert_eq!(rho.len(), d.tets.len(), "{what}");
+        assert_eq!(cen.len(), d.tets.len(), "{what}");
+        for t in 0..d.tets.len() {
+            assert_eq!(
+                rho.values[t],
+                density_at(centroid(&d, t)),
+                "{what}: tet {t}"
+            );
+            let e = cen.entry(t);
+            assert!(
+                centroids
+                    .iter()
+                    .any(|c| (0..3).all(|a| (c[a] - e[a]).abs() <= 1e-12)),
+                "{what}: tet {t}: {e:?} is no input centroid"
+            );
+        }
+    }
+}
+
+#[test]
+fn bad_element_data_is_an_error_at_its_line_and_nothing_is_written() {
+    let dir = tempfile::tempdir().unwrap();
+    // The density view's entries start after its header (11 lines).
+    let edit_density = |name: &str, edit: &dyn Fn(&mut Vec<String>, usize)| {
+        edited(dir.path(), name, |t| {
+            let mut lines: Vec<String> = t.lines().map(str::to_string).collect();
+            let h = lines
+                .iter()
+                .position(|l| l == "\"density\"")
+                .expect("the density view")
+                - 2;
+            edit(&mut lines, h);
+            lines.join("\n") + "\n"
+        })
+    };
+    let short = edit_density("short.msh", &|l, h| {
+        // One tet fewer: count and entries agree, a tet is left out.
+        assert_eq!(l[h + 9], "1455");
+        l[h + 9] = "1454".into();
+        l.remove(h + 11);
+    });
+    let ghost = edit_density("ghost.msh", &|l, h| {
+        l[h + 20] = "99999 7.85".into();
+    });
+    let nan = edit_density("nan.msh", &|l, h| {
+        let tag = l[h + 30].split_whitespace().next().unwrap().to_string();
+        l[h + 30] = format!("{tag} nan");
+    });
+    let differ = edit_density("twice.msh", &|l, h| {
+        // The same tet given twice with different values.
+        let tag = l[h + 11].split_whitespace().next().unwrap().to_string();
+        l[h + 12] = format!("{tag} 1.5");
+    });
+    let truncated = edit_density("truncated.msh", &|l, h| {
+        l.truncate(h + 40);
+    });
+    // The file ends in the middle of the last view, 1000 entries in.
+    let cut = edited(dir.path(), "cut.msh", |t| {
+        let mut lines: Vec<&str> = t.lines().collect();
+        let h = lines.iter().position(|l| *l == "\"centroid\"").unwrap() - 2;
+        lines.truncate(h + 11 + 1000);
+        lines.join("\n") + "\n"
+    });
+    let n_cut = std::fs::read_to_string(&cut).unwrap().lines().count();
+    let before = edited(dir.path(), "before.msh", |t| {
+        let (head, rest) = t.split_once("$Elements\n").unwrap();
+        let (elements, tail) = rest.split_once("$EndElements\n").unwrap();
+        let view = tail.split_once("$ElementData").unwrap().1;
+        let density = view.split_once("$EndElementData\n").unwrap().0;
+        format!("{head}$ElementData{density}$EndElementData\n$Elements\n{elements}$EndElements\n")
+    });
+    let cases = [
+        (
+            &short,
+            line_of(&short, "\"density\"") + 7,
+            "1454 of the 1455 tetrahedra",
+        ),
+        (&ghost, line_of(&ghost, "\"density\"") + 18, "element 99999"),
+        (
+            &nan,
+            line_of(&nan, "\"density\"") + 28,
+            "not a finite number",
+        ),
+        (
+            &differ,
+            line_of(&differ, "\"density\"") + 10,
+            "was given [7.85]",
+        ),
+        (
+            &truncated,
+            line_of(&truncated, "\"density\"") + 7,
+            "more than the rest of the file can hold (truncated?)",
+        ),
+        // The end of the file: just past its last line end.
+        (
+            &cut,
+            n_cut + 1,
+            "file ends where an element tag was expected (truncated?)",
+        ),
+        (
+            &before,
+            line_of(&before, "$ElementData"),
+            "comes before $Elements",
+        ),
+    ];
+    for (path, line, words) in cases {
+        let out = dir.path().join("out.msh");
+        let o = tetrefine(&[
+            "refine",
+            path.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+        ]);
+        assert!(!o.status.success());
+        let err = String::from_utf8_lossy(&o.stderr);
+        let want = format!("{}:{line}:", path.display());
+        assert!(
+            err.contains(&want) && err.contains(words),
+            "{want} {words}: {err}"
+        );
+        assert!(!err.contains("panicked"), "{err}");
+        assert!(!out.exists(), "nothing is written");
+    }
+}

@@ -363,3 +363,45 @@ fn bad_size_maps_name_the_file_and_line_and_nothing_is_written() {
     assert_eq!(o.status.code(), Some(1));
     assert!(files_in(dir.path()).is_empty());
 }
+
+#[test]
+fn indicator_sol_is_read_as_an_indicator_with_a_note_and_size_sol_as_sizes() {
+    // The same file, both meanings: as an indicator, x + 0.5 per point
+    // (a tet takes its vertices' maximum) selects with threshold:4.2 the
+    // tets touching x = 4: every tet of the 16 cubes of the last layer,
+    // 6 × 16 = 96; as a size map it is read silently as lengths.
+    let dir = tempfile::tempdir().unwrap();
+    let (input, mesh) = block(dir.path());
+    let rows: Vec<Vec<f64>> = mesh.points().iter().map(|p| vec![p.x + 0.5]).collect();
+    let sol = dir.path().join("s.sol");
+    write_sol(&sol, 1, &rows);
+    let out = dir.path().join("o.mesh");
+    let o = ok(&[
+        "refine",
+        &input,
+        "-o",
+        out.to_str().unwrap(),
+        "--indicator",
+        sol.to_str().unwrap(),
+        "--mark",
+        "threshold:4.2",
+    ]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("read as an error indicator"), "{err}");
+    assert!(
+        err.contains("an MMG size map (target edge lengths) is --size FILE.sol"),
+        "{err}"
+    );
+    assert!(err.contains("selected 96 of 384 tets"), "{err}");
+    let o = ok(&[
+        "refine",
+        &input,
+        "-o",
+        out.to_str().unwrap(),
+        "--size",
+        sol.to_str().unwrap(),
+    ]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(!err.contains("error indicator"), "{err}");
+    assert!(err.contains("size pass 1"), "{err}");
+}
