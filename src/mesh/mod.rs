@@ -429,9 +429,9 @@ impl TetMesh {
     ///
     /// Crate-private, as are `alloc_tet` and `kill_tet`: a
     /// sequence such as `bond(a, b); bond(c, b)` leaves `a` pointing at a
-    /// face that points elsewhere, and the bulk flip's `unsafe` relies on
-    /// adjacency being mutual. Users change the mesh through the checked
-    /// operations only:
+    /// face that points elsewhere, and the bulk operations' one writer per
+    /// adjacency entry (so their determinism) relies on adjacency being
+    /// mutual. Users change the mesh through the checked operations only:
     ///
     /// ```compile_fail
     /// let mut mesh = tetrefine::TetMesh::default();
