@@ -4,25 +4,12 @@
 use glam::DVec3;
 use std::collections::HashSet;
 use std::path::{Path, PathBuf};
-use std::process::Command;
 use tetrefine::contains;
 use tetrefine::io::load_mesh;
 use tetrefine::io::read_tet_cell_array;
 use tetrefine::{MeshStats, TetMesh};
 
-fn bin() -> Command {
-    crate::tetrefine_command()
-}
-
-fn run(args: &[&str]) -> std::process::Output {
-    let o = bin().args(args).output().unwrap();
-    assert!(
-        o.status.success(),
-        "{args:?}: {}",
-        String::from_utf8_lossy(&o.stderr)
-    );
-    o
-}
+use crate::{load_checked, refine_ok, run_ok as run};
 
 fn centroid(m: &TetMesh, t: u32) -> DVec3 {
     let p = m.tet_points(t);
@@ -73,24 +60,23 @@ fn tripod_top_284_two_steps_is_conforming_and_far_tets_are_untouched() {
     let out = dir.path().join("out.mesh");
     let stats = dir.path().join("s.json");
     let fraction = format!("fraction:{}", 284.0 / 2799.0);
-    let o = run(&[
-        "refine",
+    let o = refine_ok(
         "meshes/tripod.mesh",
-        "-o",
-        out.to_str().unwrap(),
-        "--steps",
-        "2",
-        "--indicator",
-        ind.to_str().unwrap(),
-        "--mark",
-        &fraction,
-        "--stats",
-        stats.to_str().unwrap(),
-    ]);
-    let err = String::from_utf8_lossy(&o.stderr);
+        &out,
+        &[
+            "--steps",
+            "2",
+            "--indicator",
+            ind.to_str().unwrap(),
+            "--mark",
+            &fraction,
+            "--stats",
+            stats.to_str().unwrap(),
+        ],
+    );
+    let err = crate::stderr(&o);
     assert!(err.contains("selected 284 of 2799"), "{err}");
-    let (m, _) = load_mesh(&out).unwrap();
-    m.check().unwrap();
+    let m = load_checked(&out);
     let s = MeshStats::compute(&m);
     assert_eq!(s.inverted, 0);
     // Tets sharing no vertex with the selection are bit-identical.
@@ -265,7 +251,7 @@ fn malformed_indicator_files_fail_cleanly() {
             path.display().to_string()
         };
         let out = dir.path().join("o.mesh");
-        let o = bin()
+        let o = crate::tetrefine_command()
             .args([
                 "refine",
                 "meshes/mmg_cube.mesh",
