@@ -29,7 +29,7 @@
 //! slots, generations and vertex → tet entries). Seed paper §3.1 (Figure 5).
 
 use crate::geom::all_positive;
-use crate::mesh::{TetMesh, DEAD, NO_ADJ};
+use crate::mesh::{SharedSlots, TetMesh, DEAD, NO_ADJ};
 use crate::topo::scatter::{LastTouch, Shared};
 use crate::topo::TET_FACES;
 use glam::DVec3;
@@ -326,12 +326,14 @@ pub fn flip23_bulk(mesh: &mut TetMesh, batch: FlipBatch) -> usize {
     let last = LastTouch::new(mesh.points.len());
 
     {
-        let tets = Shared::new(&mut mesh.tets);
-        let adj = Shared::new(&mut mesh.adj);
-        let generation = Shared::new(&mut mesh.generation);
-        let region = Shared::new(&mut mesh.region);
-        let level = Shared::new(&mut mesh.level);
-        let parent = Shared::new(&mut mesh.parent);
+        let SharedSlots {
+            tets,
+            adj,
+            generation,
+            region,
+            level,
+            parent,
+        } = mesh.shared_slots();
         let (role, flips, last) = (&role, &flips, &last);
         // Descending, so that most `LastTouch` records are no-ops.
         flips.par_iter().enumerate().rev().for_each(|(i, &fl)| {

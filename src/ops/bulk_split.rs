@@ -28,8 +28,8 @@
 //! refinement.
 
 use crate::geom::all_positive;
-use crate::mesh::{TetMesh, DEAD, NO_ADJ};
-use crate::topo::scatter::{LastTouch, Shared};
+use crate::mesh::{SharedSlots, TetMesh, DEAD, NO_ADJ};
+use crate::topo::scatter::LastTouch;
 use glam::DVec3;
 use rayon::prelude::*;
 
@@ -129,12 +129,14 @@ pub fn split14_bulk(mesh: &mut TetMesh, selection: Option<&[bool]>) -> usize {
 
     // Children and adjacency, one task per split tet.
     {
-        let tets = Shared::new(&mut mesh.tets);
-        let adj = Shared::new(&mut mesh.adj);
-        let generation = Shared::new(&mut mesh.generation);
-        let region = Shared::new(&mut mesh.region);
-        let level = Shared::new(&mut mesh.level);
-        let parent = Shared::new(&mut mesh.parent);
+        let SharedSlots {
+            tets,
+            adj,
+            generation,
+            region,
+            level,
+            parent,
+        } = mesh.shared_slots();
         let number = &number;
         ids.par_iter().enumerate().for_each(|(i, &t)| {
             let ti = t as usize;

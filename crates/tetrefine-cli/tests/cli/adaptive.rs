@@ -4,6 +4,7 @@
 use glam::DVec3;
 use std::collections::HashSet;
 use std::path::{Path, PathBuf};
+use std::process::Output;
 use tetrefine::contains;
 use tetrefine::io::load_mesh;
 use tetrefine::io::read_tet_cell_array;
@@ -51,29 +52,33 @@ fn top_284(m: &TetMesh) -> HashSet<u32> {
     ids.into_iter().take(284).collect()
 }
 
+/// The paper's second example: two steps of the tripod with its 284 top
+/// tets marked by a height indicator written in `dir`, output to `out`, with
+/// `extra` arguments; returns the input mesh and the (successful) run.
+fn refine_top_284(dir: &Path, out: &Path, extra: &[&str]) -> (TetMesh, Output) {
+    let (input, _) = load_mesh(&crate::support::path("meshes/tripod.mesh")).unwrap();
+    let ind = dir.join("z.txt");
+    z_indicator(&input, &ind);
+    let fraction = format!("fraction:{}", 284.0 / 2799.0);
+    let mut args = vec![
+        "--steps",
+        "2",
+        "--indicator",
+        ind.to_str().unwrap(),
+        "--mark",
+        &fraction,
+    ];
+    args.extend_from_slice(extra);
+    let o = refine_ok("meshes/tripod.mesh", out, &args);
+    (input, o)
+}
+
 #[test]
 fn tripod_top_284_two_steps_is_conforming_and_far_tets_are_untouched() {
     let dir = tempfile::tempdir().unwrap();
-    let (input, _) = load_mesh(&crate::support::path("meshes/tripod.mesh")).unwrap();
-    let ind = dir.path().join("z.txt");
-    z_indicator(&input, &ind);
     let out = dir.path().join("out.mesh");
     let stats = dir.path().join("s.json");
-    let fraction = format!("fraction:{}", 284.0 / 2799.0);
-    let o = refine_ok(
-        "meshes/tripod.mesh",
-        &out,
-        &[
-            "--steps",
-            "2",
-            "--indicator",
-            ind.to_str().unwrap(),
-            "--mark",
-            &fraction,
-            "--stats",
-            stats.to_str().unwrap(),
-        ],
-    );
+    let (input, o) = refine_top_284(dir.path(), &out, &["--stats", stats.to_str().unwrap()]);
     let err = crate::stderr(&o);
     assert!(err.contains("selected 284 of 2799"), "{err}");
     let m = load_checked(&out);
@@ -116,29 +121,19 @@ fn tripod_top_284_two_steps_is_conforming_and_far_tets_are_untouched() {
 #[test]
 fn parent_holds_the_centroid_and_level_counts_refinements() {
     let dir = tempfile::tempdir().unwrap();
-    let (input, _) = load_mesh(&crate::support::path("meshes/tripod.mesh")).unwrap();
-    let ind = dir.path().join("z.txt");
-    z_indicator(&input, &ind);
     let out = dir.path().join("out.vtu");
     let map = dir.path().join("parents.txt");
-    let fraction = format!("fraction:{}", 284.0 / 2799.0);
-    run(&[
-        "refine",
-        "meshes/tripod.mesh",
-        "-o",
-        out.to_str().unwrap(),
-        "--steps",
-        "2",
-        "--boundary",
-        "linear",
-        "--indicator",
-        ind.to_str().unwrap(),
-        "--mark",
-        &fraction,
-        "--parent-map",
-        map.to_str().unwrap(),
-    ]);
-    let (m, _) = load_mesh(&out).unwrap();
+    let (input, _) = refine_top_284(
+        dir.path(),
+        &out,
+        &[
+            "--boundary",
+            "linear",
+            "--parent-map",
+            map.to_str().unwrap(),
+        ],
+    );
+    let m = load_checked(&out);
     let level = read_tet_cell_array(&out, "level").unwrap().values;
     let parent = read_tet_cell_array(&out, "parent").unwrap().values;
     let marked = read_tet_cell_array(&out, "marked").unwrap().values;
