@@ -117,7 +117,7 @@ impl<'a, T: Atomic> Shared<'a, T> {
         // some 32-bit targets.
         assert_eq!(size_of::<T::Atom>(), size_of::<T>());
         assert!(
-            (s.as_ptr() as usize).is_multiple_of(align_of::<T::Atom>()),
+            (s.as_ptr() as usize) % align_of::<T::Atom>() == 0,
             "slice aligned for its atomic view"
         );
         // SAFETY: `Atomic` guarantees equal size and bit validity, the
