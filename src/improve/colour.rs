@@ -16,7 +16,7 @@
 //! colour byte per point rather than a colour mask per tet.
 
 use crate::mesh::{TetMesh, DEAD};
-use crate::topo::scatter::Disjoint;
+use crate::topo::scatter::CountingSort;
 use rayon::prelude::*;
 
 /// The balls (incident tets) of a list of vertices, in one flat array.
@@ -59,7 +59,7 @@ impl Balls {
         let slots = mesh.tet_slots();
         let parts = rayon::current_num_threads().max(1) * 2;
         let per = slots.len().div_ceil(parts).max(1);
-        let mut counts: Vec<Vec<u32>> = slots
+        let counts: Vec<Vec<u32>> = slots
             .par_chunks(per)
             .map(|part| {
                 let mut c = vec![0u32; verts.len()];
@@ -75,44 +75,26 @@ impl Balls {
                 c
             })
             .collect();
-        // Counts become each part's first position in each ball.
-        let mut offsets = vec![0usize; verts.len() + 1];
-        let mut at = 0usize;
-        for i in 0..verts.len() {
-            offsets[i] = at;
-            for c in counts.iter_mut() {
-                let n = c[i] as usize;
-                c[i] = at as u32;
-                at += n;
-            }
-        }
-        offsets[verts.len()] = at;
-        assert!(at <= u32::MAX as usize, "ball entries fit in u32");
-        let mut tets = vec![0u32; at];
-        {
-            // Each part writes only the positions its counts reserved.
-            let out = Disjoint::new(&mut tets);
-            let out = &out;
-            slots
-                .par_chunks(per)
-                .zip(counts.par_iter_mut())
-                .enumerate()
-                .for_each(|(p, (part, fill))| {
-                    let base = (p * per) as u32;
-                    for (k, tv) in part.iter().enumerate() {
-                        if tv[0] != DEAD {
-                            for &x in tv {
-                                if let Some(i) = position(x) {
-                                    // SAFETY: fill[i] runs over this part's
-                                    // own stretch of ball i: one writer.
-                                    unsafe { out.write(fill[i] as usize, base + k as u32) };
-                                    fill[i] += 1;
-                                }
+        // Each part writes only the positions its counts reserved, ball by
+        // ball: the order of one sequential pass.
+        let sort = CountingSort::new(counts, verts.len());
+        let offsets: Vec<usize> = (0..=verts.len()).map(|i| sort.key_start(i)).collect();
+        let tets = sort.fill(
+            0u32,
+            slots.par_chunks(per).enumerate(),
+            |(p, part), fill| {
+                let base = (p * per) as u32;
+                for (k, tv) in part.iter().enumerate() {
+                    if tv[0] != DEAD {
+                        for &x in tv {
+                            if let Some(i) = position(x) {
+                                fill.put(i, base + k as u32);
                             }
                         }
                     }
-                });
-        }
+                }
+            },
+        );
         Balls { offsets, tets }
     }
 

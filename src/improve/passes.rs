@@ -20,7 +20,7 @@ use crate::mesh::{edge_key, EdgeKey, TetMesh};
 use crate::ops::edge_removal::{apply_ring_triangulation, RingTriangulation};
 use crate::ops::edge_removal::{best_ring_triangulation_above, RingScratch};
 use crate::ops::EdgeRing;
-use crate::topo::scatter::Disjoint;
+use crate::topo::scatter::Shared;
 use crate::topo::{EDGE_OF, TET_EDGES};
 use glam::DVec3;
 use rayon::prelude::*;
@@ -675,8 +675,8 @@ fn apply_moves(
         return n;
     }
     let mesh = &*mesh;
-    let tq = Disjoint::new(&mut tr.tq);
-    let tet_dirty = Disjoint::new(&mut tr.tet_dirty);
+    let tq = Shared::new(&mut tr.tq);
+    let tet_dirty = Shared::new(&mut tr.tet_dirty);
     let vert_dirty = &tr.vert_dirty;
     group
         .par_iter()
@@ -685,11 +685,9 @@ fn apply_moves(
         .for_each(|(&i, m)| {
             let Some(m) = m else { return };
             for (&t, &q) in balls.ball(i as usize).iter().zip(&m.qualities) {
-                // SAFETY: the balls of a class share no tet slot.
-                unsafe {
-                    tq.write(t as usize, q);
-                    tet_dirty.write(t as usize, true);
-                }
+                // The balls of a class share no tet slot: one writer each.
+                tq.set(t as usize, q);
+                tet_dirty.set(t as usize, true);
                 for v in mesh.tet(t) {
                     vert_dirty[v as usize].store(true, Ordering::Relaxed);
                 }

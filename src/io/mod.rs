@@ -32,6 +32,7 @@ pub use gmsh::MshFormat;
 pub use indicator::{read_indicator, IndicatorSource};
 pub use meshb::{read_sol, write_sol, SolAt, SolFile, Solution};
 pub use meta::{Field, MeshMeta};
+pub use off::{read_off, OffFile};
 pub use plc::{Facet, Plc, PlcError, PlcVolume, Region, SeedLines};
 /// The pieces of a VTK XML PolyData (`.vtp`) file, for writers of other
 /// polygonal data (the surface schemes' meshes) that share the layout of

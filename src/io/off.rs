@@ -1,18 +1,48 @@
-//! Object File Format `.off` (Geomview), ASCII, read into a [`Plc`].
+//! Object File Format `.off` (Geomview), ASCII: the one OFF reader, read
+//! into an [`OffFile`] (also by the `tetrefine-surface` crate) or a [`Plc`].
 //!
 //! `OFF` (or `COFF`, `NOFF`, `CNOFF`, `STOFF`…: per-vertex extras are
 //! ignored), then `<#vertices> <#faces> <#edges>` (on the header line or the
 //! next), one line per vertex `x y z [extras]`, one line per face
-//! `k i1 … ik [colour]` with 0-based indices. `#` starts a comment. Every face
-//! becomes a facet with marker 0 (OFF has no markers).
+//! `k i1 … ik [colour]` with 0-based indices. `#` starts a comment. In a
+//! [`Plc`] every face becomes a facet with marker 0 (OFF has no markers).
 
 use super::plc::{Facet, Plc};
 use super::text::as_text;
 use super::{read_bytes, IoError};
 use std::path::Path;
 
-/// Reads an ASCII OFF file.
+/// The points and faces of an OFF file, with the line of each face.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct OffFile {
+    /// Vertex coordinates, all finite.
+    pub points: Vec<[f64; 3]>,
+    /// Faces as 0-based vertex ids, each with at least three, all in range.
+    pub faces: Vec<Vec<u32>>,
+    /// The 1-based line of each face.
+    pub face_lines: Vec<u32>,
+}
+
+/// Reads an ASCII OFF file into a [`Plc`], one facet per face.
 pub fn read(path: &Path) -> Result<Plc, IoError> {
+    let off = read_off(path)?;
+    Ok(Plc {
+        points: off.points,
+        facets: off
+            .faces
+            .into_iter()
+            .map(|poly| Facet {
+                polygons: vec![poly],
+                holes: Vec::new(),
+                marker: 0,
+            })
+            .collect(),
+        ..Default::default()
+    })
+}
+
+/// Reads an ASCII OFF file: points, faces and the line of each face.
+pub fn read_off(path: &Path) -> Result<OffFile, IoError> {
     let bytes = read_bytes(path)?;
     let text = as_text(path, &bytes)?;
     let mut lines = text.lines().enumerate().filter_map(|(i, l)| {
@@ -96,7 +126,8 @@ pub fn read(path: &Path) -> Result<Plc, IoError> {
         }
         points.push(p);
     }
-    let mut facets = Vec::with_capacity(nf);
+    let mut faces = Vec::with_capacity(nf);
+    let mut face_lines = Vec::with_capacity(nf);
     for _ in 0..nf {
         let (l, t) = lines.next().ok_or_else(|| {
             err(
@@ -134,15 +165,12 @@ pub fn read(path: &Path) -> Result<Plc, IoError> {
                 Err(_) => return Err(err(l, format!("expected a vertex index, found '{tok}'"))),
             }
         }
-        facets.push(Facet {
-            polygons: vec![poly],
-            holes: Vec::new(),
-            marker: 0,
-        });
+        faces.push(poly);
+        face_lines.push(u32::try_from(l).expect("a line number fits in u32"));
     }
-    Ok(Plc {
+    Ok(OffFile {
         points,
-        facets,
-        ..Default::default()
+        faces,
+        face_lines,
     })
 }

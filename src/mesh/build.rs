@@ -3,7 +3,7 @@
 
 use super::{edge_key, face_key, MeshData, TetMesh, NO_ADJ};
 use crate::geom::{orient3d_sign, Orientation};
-use crate::topo::scatter::Disjoint;
+use crate::topo::scatter::Shared;
 use crate::topo::TET_FACES;
 use glam::DVec3;
 use rayon::prelude::*;
@@ -481,13 +481,14 @@ fn match_half_faces(
     }
     let mut entries = vec![[0u32; 3]; 4 * tets.len()];
     {
-        let out = Disjoint::new(&mut entries);
+        let out = Shared::new(&mut entries);
         tets.par_iter().enumerate().for_each(|(t, _)| {
             for f in 0..4 {
                 let k = key(t, f);
                 let at = cursor[k[0] as usize].fetch_add(1, Ordering::Relaxed);
-                // SAFETY: each cursor hands out every slot of its bucket once.
-                unsafe { out.write(at as usize, [k[1], k[2], (4 * t + f) as u32]) };
+                // Each cursor hands out every slot of its bucket once: one
+                // writer per entry.
+                out.set(at as usize, [k[1], k[2], (4 * t + f) as u32]);
             }
         });
     }
@@ -512,7 +513,7 @@ fn match_half_faces(
     }
     let mut adj = vec![[NO_ADJ; 4]; tets.len()];
     let first_error = {
-        let adj_w = Disjoint::new(&mut adj);
+        let adj_w = Shared::new(&mut adj);
         let start = &start;
         runs.into_par_iter()
             .map(|(first, run)| {
@@ -533,12 +534,10 @@ fn match_half_faces(
                             1 => {}
                             2 => {
                                 let (x, y) = (bucket[i][2], bucket[i + 1][2]);
-                                // SAFETY: every half-face is in one group only,
-                                // so its adjacency entry has one writer.
-                                unsafe {
-                                    adj_w.write_lane((x >> 2) as usize, (x & 3) as usize, y);
-                                    adj_w.write_lane((y >> 2) as usize, (y & 3) as usize, x);
-                                }
+                                // Every half-face is in one group only, so
+                                // its adjacency entry has one writer.
+                                adj_w.set_lane((x >> 2) as usize, (x & 3) as usize, y);
+                                adj_w.set_lane((y >> 2) as usize, (y & 3) as usize, x);
                             }
                             count => {
                                 let face = [b as u32, bucket[i][0], bucket[i][1]];

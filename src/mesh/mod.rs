@@ -31,6 +31,7 @@ pub use compact::Remap;
 pub use data::MeshData;
 pub use moves::ball_stays_positive;
 
+use crate::topo::scatter::Shared;
 use crate::topo::{TET_EDGES, TET_EDGE_OPPOSITE, TET_FACES};
 use fasthash::{FastHashMap, FastHashSet};
 use glam::DVec3;
@@ -95,6 +96,23 @@ pub struct TetMesh {
     /// operation re-creates tets over all vertices of the cavity it removes, and
     /// `alloc_tet` writes this entry, so it never goes stale.
     pub(crate) v2t: Vec<u32>,
+}
+
+/// [`TetMesh::shared_slots`]: the per-slot arrays, each shared by the
+/// parallel tasks of a bulk operation.
+pub(crate) struct SharedSlots<'a> {
+    /// Vertices of each slot.
+    pub(crate) tets: Shared<'a, [u32; 4]>,
+    /// Face adjacency of each slot.
+    pub(crate) adj: Shared<'a, [u32; 4]>,
+    /// Generation of each slot.
+    pub(crate) generation: Shared<'a, u32>,
+    /// Region of each slot.
+    pub(crate) region: Shared<'a, i32>,
+    /// Refinement level of each slot.
+    pub(crate) level: Shared<'a, u8>,
+    /// Parent of each slot.
+    pub(crate) parent: Shared<'a, u32>,
 }
 
 impl TetMesh {
@@ -429,9 +447,9 @@ impl TetMesh {
     ///
     /// Crate-private, as are `alloc_tet` and `kill_tet`: a
     /// sequence such as `bond(a, b); bond(c, b)` leaves `a` pointing at a
-    /// face that points elsewhere, and the bulk flip's `unsafe` relies on
-    /// adjacency being mutual. Users change the mesh through the checked
-    /// operations only:
+    /// face that points elsewhere, and the bulk operations' one writer per
+    /// adjacency entry (so their determinism) relies on adjacency being
+    /// mutual. Users change the mesh through the checked operations only:
     ///
     /// ```compile_fail
     /// let mut mesh = tetrefine::TetMesh::default();
@@ -509,6 +527,20 @@ impl TetMesh {
         self.region.reserve_exact(n);
         self.level.reserve_exact(n);
         self.parent.reserve_exact(n);
+    }
+
+    /// The per-slot arrays viewed for the parallel tasks of a bulk
+    /// operation (see [`crate::topo::scatter::Shared`]); the points and the
+    /// vertex → tet table stay as they are.
+    pub(crate) fn shared_slots(&mut self) -> SharedSlots<'_> {
+        SharedSlots {
+            tets: Shared::new(&mut self.tets),
+            adj: Shared::new(&mut self.adj),
+            generation: Shared::new(&mut self.generation),
+            region: Shared::new(&mut self.region),
+            level: Shared::new(&mut self.level),
+            parent: Shared::new(&mut self.parent),
+        }
     }
 
     /// Claims `n` tet slots for a bulk operation, in the order `n` calls of

@@ -8,7 +8,7 @@
 
 use super::fasthash::{FastHashMap, FastHashSet};
 use super::{edge_key, face_key, Remap, TetMesh, DEAD, NO_ADJ};
-use crate::topo::scatter::{Disjoint, LastTouch};
+use crate::topo::scatter::{permute_into, CountingSort, LastTouch};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicU32, Ordering};
 
@@ -101,15 +101,14 @@ impl TetMesh {
             .collect();
         // Compacted id → new id, for the tag tables (keyed by compacted ids
         // after the compaction's pass).
-        let mut cmap = vec![0u32; np];
-        {
-            let out = Disjoint::new(&mut cmap);
-            let out = &out;
-            codes.par_iter().enumerate().for_each(|(new, &(_, old))| {
-                // SAFETY: compacted ids of distinct used points are distinct.
-                unsafe { out.write(pmap[old as usize] as usize, new as u32) }
-            });
-        }
+        // Compacted ids of distinct used points are distinct: a permutation.
+        let cmap = permute_into(
+            np,
+            codes
+                .par_iter()
+                .enumerate()
+                .map(|(new, &(_, old))| (pmap[old as usize] as usize, new as u32)),
+        );
         drop(codes);
         self.remap_tags(&pmap, &cmap);
         // Old id → new id.
@@ -243,7 +242,7 @@ impl TetMesh {
         // point.
         let parts = rayon::current_num_threads().clamp(1, 8);
         let per = map.len().div_ceil(parts).max(1);
-        let mut counts: Vec<Vec<u32>> = map
+        let counts: Vec<Vec<u32>> = map
             .par_chunks(per)
             .map(|part| {
                 let mut c = vec![0u32; np];
@@ -253,34 +252,18 @@ impl TetMesh {
                 c
             })
             .collect();
-        let mut at = 0u32;
-        for k in 0..np {
-            for c in counts.iter_mut() {
-                let n = c[k];
-                c[k] = at;
-                at += n;
-            }
-        }
-        let mut order = vec![0u32; at as usize];
-        {
-            let out = Disjoint::new(&mut order);
-            let out = &out;
-            map.par_chunks_mut(per)
-                .zip(counts.par_iter_mut())
-                .enumerate()
-                .for_each(|(i, (part, fill))| {
-                    for (t, k) in part.iter_mut().enumerate() {
-                        if *k != DEAD {
-                            let f = &mut fill[*k as usize];
-                            // SAFETY: fill[k] runs over this part's own
-                            // stretch of key k: one writer.
-                            unsafe { out.write(*f as usize, (i * per + t) as u32) };
-                            *k = *f;
-                            *f += 1;
-                        }
+        // Each part fills its own stretch of every key.
+        let order = CountingSort::new(counts, np).fill(
+            0u32,
+            map.par_chunks_mut(per).enumerate(),
+            |(i, part), fill| {
+                for (t, k) in part.iter_mut().enumerate() {
+                    if *k != DEAD {
+                        *k = fill.put(*k as usize, (i * per + t) as u32);
                     }
-                });
-        }
+                }
+            },
+        );
         TetOrder { map, order }
     }
 }

@@ -29,8 +29,8 @@
 //! slots, generations and vertex → tet entries). Seed paper §3.1 (Figure 5).
 
 use crate::geom::all_positive;
-use crate::mesh::{TetMesh, DEAD, NO_ADJ};
-use crate::topo::scatter::{Disjoint, LastTouch};
+use crate::mesh::{SharedSlots, TetMesh, DEAD, NO_ADJ};
+use crate::topo::scatter::{LastTouch, Shared};
 use crate::topo::TET_FACES;
 use glam::DVec3;
 use rayon::prelude::*;
@@ -315,97 +315,96 @@ pub fn flip23_bulk(mesh: &mut TetMesh, batch: FlipBatch) -> usize {
     // Per old slot: 2k for the t of flip k, 2k+1 for its u.
     let mut role = vec![NONE; n];
     {
-        let r = Disjoint::new(&mut role);
+        let r = Shared::new(&mut role);
         flips.par_iter_mut().enumerate().for_each(|(i, fl)| {
             fl.s = slots.get(i);
-            // SAFETY: the pairs are disjoint, so each slot has one writer.
-            unsafe {
-                r.write(fl.t as usize, 2 * i as u32);
-                r.write(fl.u as usize, 2 * i as u32 + 1);
-            }
+            // The pairs are disjoint, so each slot has one writer.
+            r.set(fl.t as usize, 2 * i as u32);
+            r.set(fl.u as usize, 2 * i as u32 + 1);
         });
     }
     let last = LastTouch::new(mesh.points.len());
 
     {
-        let tets = Disjoint::new(&mut mesh.tets);
-        let adj = Disjoint::new(&mut mesh.adj);
-        let generation = Disjoint::new(&mut mesh.generation);
-        let region = Disjoint::new(&mut mesh.region);
-        let level = Disjoint::new(&mut mesh.level);
-        let parent = Disjoint::new(&mut mesh.parent);
+        let SharedSlots {
+            tets,
+            adj,
+            generation,
+            region,
+            level,
+            parent,
+        } = mesh.shared_slots();
         let (role, flips, last) = (&role, &flips, &last);
         // Descending, so that most `LastTouch` records are no-ops.
         flips.par_iter().enumerate().rev().for_each(|(i, &fl)| {
             let (t, u, s) = (fl.t as usize, fl.u as usize, fl.s as usize);
-            // SAFETY: this task alone reads and writes slots t, u and s (the
-            // pairs are disjoint, s was claimed for this flip only); the lane
-            // it writes in an unflipped neighbour faces t or u, so no other
-            // task writes it, and no task reads unflipped neighbours.
-            unsafe {
-                let (vt, vu) = (tets.read(t), tets.read(u));
-                let (at, au) = (adj.read(t), adj.read(u));
-                let l = TET_FACES[fl.f()];
-                let [a, b, c] = [vt[l[0]], vt[l[1]], vt[l[2]]];
-                let [ia, ib, ic] = fl.in_u();
-                let p = vt[fl.f()];
-                let q = vu[6 - ia - ib - ic];
-                for x in [a, b, c, p, q] {
-                    last.touch(x, i);
-                }
-                // The outer half-face across local face m of t (side 0) or u
-                // (side 1), which becomes `dest`.
-                let outer = |side: u32, m: usize, dest: u32| {
-                    let h = if side == 0 { at[m] } else { au[m] };
-                    if h == NO_ADJ {
-                        return NO_ADJ;
-                    }
-                    let (w, mw) = TetMesh::half_face(h);
-                    match role[w as usize] {
-                        NONE => {
-                            adj.write_lane(w as usize, mw, dest);
-                            h
-                        }
-                        r => flips[(r / 2) as usize].outer_dest(r & 1, mw),
-                    }
-                };
-                let n0 = [
-                    4 * fl.t + 1,
-                    4 * fl.s,
-                    outer(1, ic, 4 * fl.u + 2),
-                    outer(0, l[2], 4 * fl.u + 3),
-                ];
-                let n1 = [
-                    4 * fl.s + 1,
-                    4 * fl.u,
-                    outer(1, ia, 4 * fl.t + 2),
-                    outer(0, l[0], 4 * fl.t + 3),
-                ];
-                let n2 = [
-                    4 * fl.u + 1,
-                    4 * fl.t,
-                    outer(1, ib, 4 * fl.s + 2),
-                    outer(0, l[1], 4 * fl.s + 3),
-                ];
-                // New tets take region, level and parent of the higher-level
-                // old tet (t on a tie), as `replace_cavity` does.
-                let o = if level.read(u) > level.read(t) { u } else { t };
-                let (r, lv, pa) = (region.read(o), level.read(o), parent.read(o));
-                for (slot, v, a) in [
-                    (u, [a, b, p, q], n0),
-                    (t, [b, c, p, q], n1),
-                    (s, [c, a, p, q], n2),
-                ] {
-                    tets.write(slot, v);
-                    adj.write(slot, a);
-                    region.write(slot, r);
-                    level.write(slot, lv);
-                    parent.write(slot, pa);
-                }
-                // Slots t and u were freed and taken again.
-                generation.write(t, generation.read(t).wrapping_add(2));
-                generation.write(u, generation.read(u).wrapping_add(2));
+            // This task alone reads and writes slots t, u and s (the pairs
+            // are disjoint, s was claimed for this flip only); the lane it
+            // writes in an unflipped neighbour faces t or u, so no other task
+            // writes it, and no task reads unflipped neighbours: one writer
+            // per element, a deterministic result.
+            let (vt, vu) = (tets.get(t), tets.get(u));
+            let (at, au) = (adj.get(t), adj.get(u));
+            let l = TET_FACES[fl.f()];
+            let [a, b, c] = [vt[l[0]], vt[l[1]], vt[l[2]]];
+            let [ia, ib, ic] = fl.in_u();
+            let p = vt[fl.f()];
+            let q = vu[6 - ia - ib - ic];
+            for x in [a, b, c, p, q] {
+                last.touch(x, i);
             }
+            // The outer half-face across local face m of t (side 0) or u
+            // (side 1), which becomes `dest`.
+            let outer = |side: u32, m: usize, dest: u32| {
+                let h = if side == 0 { at[m] } else { au[m] };
+                if h == NO_ADJ {
+                    return NO_ADJ;
+                }
+                let (w, mw) = TetMesh::half_face(h);
+                match role[w as usize] {
+                    NONE => {
+                        adj.set_lane(w as usize, mw, dest);
+                        h
+                    }
+                    r => flips[(r / 2) as usize].outer_dest(r & 1, mw),
+                }
+            };
+            let n0 = [
+                4 * fl.t + 1,
+                4 * fl.s,
+                outer(1, ic, 4 * fl.u + 2),
+                outer(0, l[2], 4 * fl.u + 3),
+            ];
+            let n1 = [
+                4 * fl.s + 1,
+                4 * fl.u,
+                outer(1, ia, 4 * fl.t + 2),
+                outer(0, l[0], 4 * fl.t + 3),
+            ];
+            let n2 = [
+                4 * fl.u + 1,
+                4 * fl.t,
+                outer(1, ib, 4 * fl.s + 2),
+                outer(0, l[1], 4 * fl.s + 3),
+            ];
+            // New tets take region, level and parent of the higher-level
+            // old tet (t on a tie), as `replace_cavity` does.
+            let o = if level.get(u) > level.get(t) { u } else { t };
+            let (r, lv, pa) = (region.get(o), level.get(o), parent.get(o));
+            for (slot, v, a) in [
+                (u, [a, b, p, q], n0),
+                (t, [b, c, p, q], n1),
+                (s, [c, a, p, q], n2),
+            ] {
+                tets.set(slot, v);
+                adj.set(slot, a);
+                region.set(slot, r);
+                level.set(slot, lv);
+                parent.set(slot, pa);
+            }
+            // Slots t and u were freed and taken again.
+            generation.set(t, generation.get(t).wrapping_add(2));
+            generation.set(u, generation.get(u).wrapping_add(2));
         });
     }
     drop(role);

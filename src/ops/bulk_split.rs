@@ -28,8 +28,8 @@
 //! refinement.
 
 use crate::geom::all_positive;
-use crate::mesh::{TetMesh, DEAD, NO_ADJ};
-use crate::topo::scatter::{Disjoint, LastTouch};
+use crate::mesh::{SharedSlots, TetMesh, DEAD, NO_ADJ};
+use crate::topo::scatter::LastTouch;
 use glam::DVec3;
 use rayon::prelude::*;
 
@@ -129,55 +129,55 @@ pub fn split14_bulk(mesh: &mut TetMesh, selection: Option<&[bool]>) -> usize {
 
     // Children and adjacency, one task per split tet.
     {
-        let tets = Disjoint::new(&mut mesh.tets);
-        let adj = Disjoint::new(&mut mesh.adj);
-        let generation = Disjoint::new(&mut mesh.generation);
-        let region = Disjoint::new(&mut mesh.region);
-        let level = Disjoint::new(&mut mesh.level);
-        let parent = Disjoint::new(&mut mesh.parent);
+        let SharedSlots {
+            tets,
+            adj,
+            generation,
+            region,
+            level,
+            parent,
+        } = mesh.shared_slots();
         let number = &number;
         ids.par_iter().enumerate().for_each(|(i, &t)| {
             let ti = t as usize;
-            // SAFETY: this task alone reads and writes slot t and the claimed
-            // slots 3i..3i+3; the one lane it writes in an unsplit neighbour
-            // faces slot t, so no other task writes it, and no task reads
-            // unsplit neighbours.
-            unsafe {
-                let v = tets.read(ti);
-                let a = adj.read(ti);
-                let (r, l, p) = (region.read(ti), level.read(ti), parent.read(ti));
-                let c = (np0 + i) as u32;
-                let cs = [0, 1, 2, 3].map(|j| child_slot(t, i, j));
-                for j in 0..4 {
-                    let mut cv = v;
-                    cv[j] = c;
-                    let mut ca = [0; 4];
-                    for (m, x) in ca.iter_mut().enumerate() {
-                        *x = 4 * cs[m] + j as u32;
-                    }
-                    ca[j] = match a[j] {
-                        NO_ADJ => NO_ADJ,
-                        h => {
-                            let (w, m) = TetMesh::half_face(h);
-                            match number[w as usize] {
-                                NONE => {
-                                    adj.write_lane(w as usize, m, 4 * cs[j] + j as u32);
-                                    h
-                                }
-                                iw => 4 * child_slot(w, iw as usize, m) + m as u32,
-                            }
-                        }
-                    };
-                    let s = cs[j] as usize;
-                    tets.write(s, cv);
-                    adj.write(s, ca);
-                    region.write(s, r);
-                    level.write(s, l.saturating_add(1));
-                    parent.write(s, p);
+            // This task alone reads and writes slot t and the claimed slots
+            // 3i..3i+3; the one lane it writes in an unsplit neighbour faces
+            // slot t, so no other task writes it, and no task reads unsplit
+            // neighbours: one writer per element, a deterministic result.
+            let v = tets.get(ti);
+            let a = adj.get(ti);
+            let (r, l, p) = (region.get(ti), level.get(ti), parent.get(ti));
+            let c = (np0 + i) as u32;
+            let cs = [0, 1, 2, 3].map(|j| child_slot(t, i, j));
+            for j in 0..4 {
+                let mut cv = v;
+                cv[j] = c;
+                let mut ca = [0; 4];
+                for (m, x) in ca.iter_mut().enumerate() {
+                    *x = 4 * cs[m] + j as u32;
                 }
-                // Slot t was freed and taken again.
-                generation.write(ti, generation.read(ti).wrapping_add(2));
+                ca[j] = match a[j] {
+                    NO_ADJ => NO_ADJ,
+                    h => {
+                        let (w, m) = TetMesh::half_face(h);
+                        match number[w as usize] {
+                            NONE => {
+                                adj.set_lane(w as usize, m, 4 * cs[j] + j as u32);
+                                h
+                            }
+                            iw => 4 * child_slot(w, iw as usize, m) + m as u32,
+                        }
+                    }
+                };
+                let s = cs[j] as usize;
+                tets.set(s, cv);
+                adj.set(s, ca);
+                region.set(s, r);
+                level.set(s, l.saturating_add(1));
+                parent.set(s, p);
             }
+            // Slot t was freed and taken again.
+            generation.set(ti, generation.get(ti).wrapping_add(2));
         });
     }
 

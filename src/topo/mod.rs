@@ -1,6 +1,7 @@
 //! Local tables of a tetrahedron, their inverses, the one edge and face key,
 //! and the parallel scatter helpers (`scatter`) that hold all of the core's
-//! `unsafe`.
+//! scatter `unsafe` (the rest: libc calls in `file::atomic` and `tetgen`,
+//! the AVX2 dispatch of `report::stats`).
 //!
 //! Local numbering: vertices `0..4`; face `f` is the triangle without vertex
 //! `f`; the six edges are listed in [`TET_EDGES`]; edge `e` joins

@@ -263,3 +263,22 @@ fn open_and_duplicated_surfaces_are_reported() {
         Err(PlcError::DuplicateFacet { facet: 7, other: 6 })
     );
 }
+
+#[test]
+fn the_one_off_reader_keeps_face_lines_and_skips_extras() {
+    let dir = tempfile::tempdir().unwrap();
+    // COFF: a colour after each vertex and face; a comment and a blank line.
+    let text = "COFF\n# a tet\n4 2 6\n0 0 0 1 0 0 1\n1 0 0 1 0 0 1\n\n0 1 0 1 0 0 1\n0 0 1 1 0 0 1\n3 0 2 1 255 0 0\n4 0 1 3 2\n";
+    let off = tetrefine::io::read_off(&write(dir.path(), "t.off", text)).unwrap();
+    assert_eq!(
+        off.points,
+        [
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.0, 0.0, 1.0]
+        ]
+    );
+    assert_eq!(off.faces, [vec![0, 2, 1], vec![0, 1, 3, 2]]);
+    assert_eq!(off.face_lines, [9, 10]);
+}

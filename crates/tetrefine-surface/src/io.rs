@@ -149,23 +149,6 @@ pub(crate) fn parse_coord(
     Ok(x)
 }
 
-/// Parses an integer, with an error at `line`.
-pub(crate) fn parse_int(
-    path: &Path,
-    line: usize,
-    tok: Option<&str>,
-    what: &str,
-) -> Result<i64, IoError> {
-    let tok = tok.ok_or_else(|| IoError::at(path, line, format!("missing {what}")))?;
-    tok.parse().map_err(|_| {
-        IoError::at(
-            path,
-            line,
-            format!("expected {what}, found '{}'", short(tok)),
-        )
-    })
-}
-
 /// A token shortened for messages.
 pub(crate) fn short(s: &str) -> String {
     if s.chars().count() > 24 {

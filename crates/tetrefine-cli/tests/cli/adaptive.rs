@@ -4,25 +4,13 @@
 use glam::DVec3;
 use std::collections::HashSet;
 use std::path::{Path, PathBuf};
-use std::process::Command;
+use std::process::Output;
 use tetrefine::contains;
 use tetrefine::io::load_mesh;
 use tetrefine::io::read_tet_cell_array;
 use tetrefine::{MeshStats, TetMesh};
 
-fn bin() -> Command {
-    crate::tetrefine_command()
-}
-
-fn run(args: &[&str]) -> std::process::Output {
-    let o = bin().args(args).output().unwrap();
-    assert!(
-        o.status.success(),
-        "{args:?}: {}",
-        String::from_utf8_lossy(&o.stderr)
-    );
-    o
-}
+use crate::{load_checked, refine_ok, run_ok as run};
 
 fn centroid(m: &TetMesh, t: u32) -> DVec3 {
     let p = m.tet_points(t);
@@ -64,33 +52,36 @@ fn top_284(m: &TetMesh) -> HashSet<u32> {
     ids.into_iter().take(284).collect()
 }
 
-#[test]
-fn tripod_top_284_two_steps_is_conforming_and_far_tets_are_untouched() {
-    let dir = tempfile::tempdir().unwrap();
+/// The paper's second example: two steps of the tripod with its 284 top
+/// tets marked by a height indicator written in `dir`, output to `out`, with
+/// `extra` arguments; returns the input mesh and the (successful) run.
+fn refine_top_284(dir: &Path, out: &Path, extra: &[&str]) -> (TetMesh, Output) {
     let (input, _) = load_mesh(&crate::support::path("meshes/tripod.mesh")).unwrap();
-    let ind = dir.path().join("z.txt");
+    let ind = dir.join("z.txt");
     z_indicator(&input, &ind);
-    let out = dir.path().join("out.mesh");
-    let stats = dir.path().join("s.json");
     let fraction = format!("fraction:{}", 284.0 / 2799.0);
-    let o = run(&[
-        "refine",
-        "meshes/tripod.mesh",
-        "-o",
-        out.to_str().unwrap(),
+    let mut args = vec![
         "--steps",
         "2",
         "--indicator",
         ind.to_str().unwrap(),
         "--mark",
         &fraction,
-        "--stats",
-        stats.to_str().unwrap(),
-    ]);
-    let err = String::from_utf8_lossy(&o.stderr);
+    ];
+    args.extend_from_slice(extra);
+    let o = refine_ok("meshes/tripod.mesh", out, &args);
+    (input, o)
+}
+
+#[test]
+fn tripod_top_284_two_steps_is_conforming_and_far_tets_are_untouched() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out.mesh");
+    let stats = dir.path().join("s.json");
+    let (input, o) = refine_top_284(dir.path(), &out, &["--stats", stats.to_str().unwrap()]);
+    let err = crate::stderr(&o);
     assert!(err.contains("selected 284 of 2799"), "{err}");
-    let (m, _) = load_mesh(&out).unwrap();
-    m.check().unwrap();
+    let m = load_checked(&out);
     let s = MeshStats::compute(&m);
     assert_eq!(s.inverted, 0);
     // Tets sharing no vertex with the selection are bit-identical.
@@ -130,29 +121,19 @@ fn tripod_top_284_two_steps_is_conforming_and_far_tets_are_untouched() {
 #[test]
 fn parent_holds_the_centroid_and_level_counts_refinements() {
     let dir = tempfile::tempdir().unwrap();
-    let (input, _) = load_mesh(&crate::support::path("meshes/tripod.mesh")).unwrap();
-    let ind = dir.path().join("z.txt");
-    z_indicator(&input, &ind);
     let out = dir.path().join("out.vtu");
     let map = dir.path().join("parents.txt");
-    let fraction = format!("fraction:{}", 284.0 / 2799.0);
-    run(&[
-        "refine",
-        "meshes/tripod.mesh",
-        "-o",
-        out.to_str().unwrap(),
-        "--steps",
-        "2",
-        "--boundary",
-        "linear",
-        "--indicator",
-        ind.to_str().unwrap(),
-        "--mark",
-        &fraction,
-        "--parent-map",
-        map.to_str().unwrap(),
-    ]);
-    let (m, _) = load_mesh(&out).unwrap();
+    let (input, _) = refine_top_284(
+        dir.path(),
+        &out,
+        &[
+            "--boundary",
+            "linear",
+            "--parent-map",
+            map.to_str().unwrap(),
+        ],
+    );
+    let m = load_checked(&out);
     let level = read_tet_cell_array(&out, "level").unwrap().values;
     let parent = read_tet_cell_array(&out, "parent").unwrap().values;
     let marked = read_tet_cell_array(&out, "marked").unwrap().values;
@@ -265,7 +246,7 @@ fn malformed_indicator_files_fail_cleanly() {
             path.display().to_string()
         };
         let out = dir.path().join("o.mesh");
-        let o = bin()
+        let o = crate::tetrefine_command()
             .args([
                 "refine",
                 "meshes/mmg_cube.mesh",

@@ -5,6 +5,7 @@
 //! physical groups are known in closed form. (Gmsh's own reader checks the
 //! written files in CI: `tests/gmsh_roundtrip.py`.)
 
+use crate::run as tetrefine;
 use crate::support;
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
@@ -164,10 +165,6 @@ fn the_three_layouts_gmsh_wrote_give_every_name_and_every_tag_of_an_entity() {
         // The 2.2 file lists each tet once per group (twice): read as one.
         assert_eq!(*tets.get_or_insert(d.tets.len()), d.tets.len(), "{f}");
     }
-}
-
-fn tetrefine(args: &[&str]) -> std::process::Output {
-    crate::tetrefine_command().args(args).output().unwrap()
 }
 
 #[test]

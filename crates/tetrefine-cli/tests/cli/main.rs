@@ -48,6 +48,30 @@ pub fn run_ok(args: &[&str]) -> Output {
     o
 }
 
+/// Standard error of a run, as text (invalid UTF-8 replaced).
+pub fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+/// `tetrefine refine INPUT -o OUT EXTRA…` from the repository root,
+/// asserting success (the message carries stderr).
+pub fn refine_ok(input: &str, out: &Path, extra: &[&str]) -> Output {
+    let out = out.to_str().expect("a UTF-8 output path");
+    let mut args = vec!["refine", input, "-o", out];
+    args.extend_from_slice(extra);
+    run_ok(&args)
+}
+
+/// The mesh a command wrote to `path`, loaded and checked (conforming,
+/// positive, adjacency mutual).
+pub fn load_checked(path: &Path) -> tetrefine::TetMesh {
+    let (m, _) =
+        tetrefine::io::load_mesh(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    m.check()
+        .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    m
+}
+
 /// The names of the files in `dir`, sorted: what a command left behind.
 pub fn files_in(dir: &Path) -> Vec<String> {
     let mut v: Vec<String> = std::fs::read_dir(dir)

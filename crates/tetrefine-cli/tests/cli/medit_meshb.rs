@@ -2,11 +2,8 @@
 //! stderr, `--fields FILE.sol` with a wrong count is an error at its line
 //! with nothing written, and `--fields-out` writes the fields back.
 
+use crate::run;
 use crate::support::path;
-
-fn run(args: &[&str]) -> std::process::Output {
-    crate::tetrefine_command().args(args).output().unwrap()
-}
 
 #[test]
 fn foreign_keywords_give_exactly_one_note_naming_them() {

@@ -7,15 +7,10 @@ use std::fmt;
 use std::path::Path;
 use std::process::Output;
 
+use crate::{run as tetrefine, run_ok as ok};
+
 const TRIPOD: &str = "meshes/tripod.mesh";
 const TRIPOD_TETS: u64 = 2799;
-
-fn tetrefine(args: &[&str]) -> Output {
-    crate::tetrefine_command()
-        .args(args)
-        .output()
-        .expect("run tetrefine")
-}
 
 fn stdout(o: &Output) -> String {
     String::from_utf8(o.stdout.clone()).unwrap()
@@ -23,12 +18,6 @@ fn stdout(o: &Output) -> String {
 
 fn stderr(o: &Output) -> String {
     String::from_utf8(o.stderr.clone()).unwrap()
-}
-
-fn ok(args: &[&str]) -> Output {
-    let o = tetrefine(args);
-    assert!(o.status.success(), "{args:?} failed: {}", stderr(&o));
-    o
 }
 
 /// Collects the keys of a JSON object in document order, nested keys as

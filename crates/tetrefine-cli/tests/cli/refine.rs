@@ -4,15 +4,7 @@
 use tetrefine::io::load_mesh;
 use tetrefine::io::read_tet_cell_array;
 
-fn run(args: &[&str]) -> std::process::Output {
-    let o = crate::tetrefine_command().args(args).output().unwrap();
-    assert!(
-        o.status.success(),
-        "{args:?}: {}",
-        String::from_utf8_lossy(&o.stderr)
-    );
-    o
-}
+use crate::run_ok as run;
 
 #[test]
 fn stop_after_gives_the_exact_counts_and_stats_list_every_step() {

@@ -8,7 +8,7 @@
 use std::path::Path;
 use tetrefine::{load_mesh, write_mesh, MeshStats, TetMesh};
 
-use crate::{files_in, run as tetrefine, run_ok as ok};
+use crate::{files_in, load_checked, refine_ok, run as tetrefine, run_ok as ok};
 
 /// A 4×4×4 block of unit cubes, six tets each, written as `.mesh`.
 fn block(dir: &Path) -> (String, TetMesh) {
@@ -92,18 +92,12 @@ fn a_size_given_as_a_vtu_point_array_is_met() {
     .unwrap();
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("o.mesh");
-    let o = tetrefine(&[
-        "refine",
+    refine_ok(
         vtu.to_str().unwrap(),
-        "-o",
-        out.to_str().unwrap(),
-        "--size-array",
-        "h",
-        "--no-transfer",
-    ]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let (m, _) = load_mesh(&out).unwrap();
-    m.check().unwrap();
+        &out,
+        &["--size-array", "h", "--no-transfer"],
+    );
+    let m = load_checked(&out);
     assert!(
         m.n_tets() > input.n_tets(),
         "the size map asks for smaller tets"
@@ -138,16 +132,8 @@ fn a_scalar_size_map_is_met_with_about_the_predicted_count_and_no_quality_loss()
     write_sol(&sol, 1, &rows);
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("o.mesh");
-    ok(&[
-        "refine",
-        &mesh_path,
-        "-o",
-        out.to_str().unwrap(),
-        "--size",
-        sol.to_str().unwrap(),
-    ]);
-    let (m, _) = load_mesh(&out).unwrap();
-    m.check().unwrap();
+    refine_ok(&mesh_path, &out, &["--size", sol.to_str().unwrap()]);
+    let m = load_checked(&out);
     assert_edges_meet_h(&m);
     // The prediction: ∫ dV / (h³ / (6√2)) over the block, h depending on x
     // only: 16 · 6√2 · ∫₀⁴ dx / h(x)³.

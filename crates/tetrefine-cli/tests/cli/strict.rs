@@ -4,21 +4,14 @@
 //! outside the domain are refused before TetGen sees them.
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Command;
 use tetrefine::io::{Facet, Plc, PlcError, Region};
 
 fn meshes() -> PathBuf {
     crate::support::root().join("meshes")
 }
 
-fn tetrefine(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_tetrefine"))
-        .args(args)
-        .output()
-        .expect("run tetrefine")
-}
-
-use crate::files_in;
+use crate::{files_in, load_checked, refine_ok, run as tetrefine, stderr};
 
 /// The unit tetrahedron's surface as `tet.obj` in `dir`, faces outward.
 fn unit_tet_obj(dir: &Path) -> PathBuf {
@@ -29,10 +22,6 @@ fn unit_tet_obj(dir: &Path) -> PathBuf {
     )
     .unwrap();
     tet
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
 }
 
 /// The byte range of the raw appended data of a `.vtu` (after `_`, before
@@ -858,18 +847,12 @@ fn the_linear_rule_keeps_a_flat_tet_exactly() {
     let want = 0.5 * 0.1 / 3.0;
     for steps in ["1", "2"] {
         let out = dir.path().join("o.mesh");
-        let o = tetrefine(&[
-            "refine",
+        refine_ok(
             input.to_str().unwrap(),
-            "-o",
-            out.to_str().unwrap(),
-            "--boundary",
-            "linear",
-            "--steps",
-            steps,
-        ]);
-        assert!(o.status.success(), "{}", stderr(&o));
-        let (m, _) = tetrefine::io::load_mesh(&out).unwrap();
+            &out,
+            &["--boundary", "linear", "--steps", steps],
+        );
+        let m = load_checked(&out);
         assert!(m.n_tets() > 1, "refined");
         let v: f64 = m
             .tet_ids()
