@@ -9,6 +9,7 @@
 //! (closed rings inside one region) are removed, so the domain, its regions
 //! and its tags are untouched.
 
+use super::boundary_smooth::{BoundarySmoothOptions, BoundarySmoothReport, BoundarySmoother};
 use super::colour::{colour_balls_except, sequential_levels, Balls};
 use super::laplacian::{laplacian_position_in, BallNow};
 use super::optimize::{optimize_position_in, OptimizeParams};
@@ -52,6 +53,9 @@ pub struct ImproveOptions {
     /// are gathered at once, about 90 bytes a vertex, and each block costs a
     /// scan over the tet slots.
     pub smooth_block: usize,
+    /// Boundary and interface vertices smoothed inside their patch
+    /// ([`super::boundary_smooth`]); `None`: the boundary stays fixed.
+    pub boundary: Option<BoundarySmoothOptions>,
 }
 
 impl Default for ImproveOptions {
@@ -65,6 +69,7 @@ impl Default for ImproveOptions {
             movable: None,
             tet_allowed: None,
             smooth_block: 1 << 20,
+            boundary: Some(BoundarySmoothOptions::default()),
         }
     }
 }
@@ -80,6 +85,10 @@ pub struct ImproveReport {
     pub laplacian_moves: usize,
     /// Vertices moved by optimization-based smoothing.
     pub optimized_moves: usize,
+    /// Boundary and interface vertices moved inside their patch.
+    pub surface_moves: usize,
+    /// Feature-line vertices moved along their line.
+    pub line_moves: usize,
 }
 
 /// Work-tracking state of [`improve`]: per-slot quality and dirty flags, so
@@ -169,15 +178,70 @@ pub fn improve(mesh: &mut TetMesh, opts: &ImproveOptions) -> ImproveReport {
     let mut report = ImproveReport::default();
     let mut tr = Tracker::new(mesh, opts.tet_allowed.clone());
     let mut edges = EdgeRemoval::default();
+    let surface = opts
+        .boundary
+        .as_ref()
+        .map(|b| BoundarySmoother::new(mesh, b.clone()));
     for _ in 0..opts.passes {
         report.passes += 1;
         let mut changed = edges.pass(mesh, &mut tr, opts, &mut report);
         changed += smooth_pass(mesh, &mut tr, &movable, opts, &mut report);
+        if let Some(s) = &surface {
+            changed += boundary_pass(mesh, &mut tr, s, opts, &mut report);
+        }
         if changed == 0 {
             break;
         }
     }
     report
+}
+
+/// Boundary smoothing of the dirty surface and line vertices (allowed by
+/// `opts.movable`) whose worst tet is below the Laplacian bar, one by one in
+/// vertex order. Returns the number of vertices moved.
+fn boundary_pass(
+    mesh: &mut TetMesh,
+    tr: &mut Tracker,
+    s: &BoundarySmoother,
+    opts: &ImproveOptions,
+    report: &mut ImproveReport,
+) -> usize {
+    let bar = opts.threshold.max(opts.laplacian_threshold);
+    let mut vq = vec![f64::INFINITY; mesh.n_points()];
+    for (t, tv) in mesh.tet_slots().iter().enumerate() {
+        let q = tr.tq[t];
+        if q.is_finite() && mesh.is_alive(t as u32) {
+            for &x in tv {
+                let s = &mut vq[x as usize];
+                *s = s.min(q);
+            }
+        }
+    }
+    let verts: Vec<u32> = s
+        .movable_vertices()
+        .into_iter()
+        .filter(|&v| {
+            let dirty = tr.vert_dirty[v as usize].get_mut();
+            let take = *dirty
+                && vq[v as usize] < bar
+                && opts
+                    .movable
+                    .as_ref()
+                    .is_none_or(|m| m.get(v as usize).copied().unwrap_or(false));
+            if take {
+                *dirty = false;
+            }
+            take
+        })
+        .collect();
+    let mut r = BoundarySmoothReport::default();
+    let changed = s.pass(mesh, &verts, &mut r);
+    for (t, q) in changed {
+        tr.set(mesh, t, q);
+    }
+    report.surface_moves += r.surface_moves;
+    report.line_moves += r.line_moves;
+    r.surface_moves + r.line_moves
 }
 
 /// A removable edge found by the search half of an edge removal pass: the
