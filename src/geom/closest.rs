@@ -81,8 +81,14 @@ mod tests {
         let (q, w) = closest_point_on_triangle(DVec3::new(0.25, 0.25, 3.0), a, b, c);
         assert_eq!(q, DVec3::new(0.25, 0.25, 0.0));
         assert!((w[0] - 0.5).abs() < 1e-15);
-        assert_eq!(closest_point_on_triangle(DVec3::new(-1.0, -1.0, 0.0), a, b, c).0, a);
-        assert_eq!(closest_point_on_triangle(DVec3::new(2.0, -1.0, 0.0), a, b, c).0, b);
+        assert_eq!(
+            closest_point_on_triangle(DVec3::new(-1.0, -1.0, 0.0), a, b, c).0,
+            a
+        );
+        assert_eq!(
+            closest_point_on_triangle(DVec3::new(2.0, -1.0, 0.0), a, b, c).0,
+            b
+        );
         let (q, w) = closest_point_on_triangle(DVec3::new(1.0, 1.0, 0.0), a, b, c);
         assert!((q - DVec3::new(0.5, 0.5, 0.0)).length() < 1e-15);
         assert!((w[1] - 0.5).abs() < 1e-15 && (w[2] - 0.5).abs() < 1e-15);
@@ -91,7 +97,12 @@ mod tests {
             DVec3::new(0.5, 0.0, 0.0)
         );
         // 3-4-5: the distance from (0, 0, 0) to the far edge.
-        let d = distance_to_triangle(DVec3::ZERO, DVec3::new(3.0, -1.0, 4.0), DVec3::new(3.0, 1.0, 4.0), DVec3::new(3.0, 0.0, 9.0));
+        let d = distance_to_triangle(
+            DVec3::ZERO,
+            DVec3::new(3.0, -1.0, 4.0),
+            DVec3::new(3.0, 1.0, 4.0),
+            DVec3::new(3.0, 0.0, 9.0),
+        );
         assert!((d - 5.0).abs() < 1e-15);
     }
 }

@@ -62,6 +62,10 @@ pub struct BoundarySmoothOptions {
     /// bound even on a piecewise-planar part. 45° is MMG's ridge angle and
     /// the default of `--feature-angle`.
     pub crease_angle: f64,
+    /// Remove boundary sliver caps (tets with two boundary faces) within
+    /// the Hausdorff bound ([`crate::ops::remove_boundary_cap`]); off for
+    /// the linear rule, whose domain must stay the input's exactly.
+    pub remove_caps: bool,
 }
 
 impl Default for BoundarySmoothOptions {
@@ -72,6 +76,7 @@ impl Default for BoundarySmoothOptions {
             threshold: 0.5,
             laplacian_threshold: 0.7,
             crease_angle: 45.0,
+            remove_caps: true,
         }
     }
 }
@@ -466,7 +471,8 @@ impl BoundarySmoother {
                 for s in samples {
                     dev = dev.max(self.project_on(s, scratch).1);
                 }
-                to_ref = to_ref.min((closest_point_on_triangle(r0, p[0], p[1], p[2]).0 - r0).length());
+                to_ref =
+                    to_ref.min((closest_point_on_triangle(r0, p[0], p[1], p[2]).0 - r0).length());
             }
             if to_ref.is_finite() {
                 dev = dev.max(to_ref);

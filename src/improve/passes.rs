@@ -21,6 +21,7 @@ use crate::mesh::{edge_key, EdgeKey, TetMesh};
 use crate::ops::edge_removal::{apply_ring_triangulation, RingTriangulation};
 use crate::ops::edge_removal::{best_ring_triangulation_above, RingScratch};
 use crate::ops::EdgeRing;
+use crate::ops::{is_cap_below, remove_boundary_cap, CapLimits};
 use crate::topo::scatter::Disjoint;
 use crate::topo::{EDGE_OF, TET_EDGES};
 use glam::DVec3;
@@ -89,6 +90,8 @@ pub struct ImproveReport {
     pub surface_moves: usize,
     /// Feature-line vertices moved along their line.
     pub line_moves: usize,
+    /// Boundary sliver caps removed ([`crate::ops::remove_boundary_cap`]).
+    pub caps_removed: usize,
 }
 
 /// Work-tracking state of [`improve`]: per-slot quality and dirty flags, so
@@ -178,6 +181,11 @@ pub fn improve(mesh: &mut TetMesh, opts: &ImproveOptions) -> ImproveReport {
     let mut report = ImproveReport::default();
     let mut tr = Tracker::new(mesh, opts.tet_allowed.clone());
     let mut edges = EdgeRemoval::default();
+    // Caps go before the smoother takes the boundary as its reference, and
+    // again after the passes for those the passes left.
+    if let Some(b) = &opts.boundary {
+        cap_pass(mesh, &mut tr, b, opts, &mut report);
+    }
     let surface = opts
         .boundary
         .as_ref()
@@ -193,7 +201,59 @@ pub fn improve(mesh: &mut TetMesh, opts: &ImproveOptions) -> ImproveReport {
             break;
         }
     }
+    if let Some(b) = &opts.boundary {
+        if opts.passes > 0 {
+            cap_pass(mesh, &mut tr, b, opts, &mut report);
+        }
+    }
     report
+}
+
+/// Removes the boundary caps (tets with two boundary faces) below
+/// `opts.threshold` that may go under the Hausdorff bound of `b` (absolute,
+/// or relative to the cap's mean edge length), one by one in slot order.
+/// Returns the number removed.
+fn cap_pass(
+    mesh: &mut TetMesh,
+    tr: &mut Tracker,
+    b: &BoundarySmoothOptions,
+    opts: &ImproveOptions,
+    report: &mut ImproveReport,
+) -> usize {
+    if !b.remove_caps {
+        return 0;
+    }
+    let candidates: Vec<u32> = (0..mesh.n_tet_slots() as u32)
+        .filter(|&t| {
+            mesh.is_alive(t)
+                && tr.tq[t as usize] < opts.threshold
+                && tr.is_allowed(t)
+                && is_cap_below(mesh, t, opts.threshold)
+        })
+        .collect();
+    let mut removed = 0;
+    for t in candidates {
+        let p = mesh.tet_points(t);
+        let mean_edge = crate::topo::TET_EDGES
+            .iter()
+            .map(|e| p[e[0]].distance(p[e[1]]))
+            .sum::<f64>()
+            / 6.0;
+        let limits = CapLimits {
+            hausd: b.hausd.unwrap_or(b.hausd_rel * mean_edge),
+            crease_angle: b.crease_angle,
+        };
+        let verts = mesh.tet(t);
+        if remove_boundary_cap(mesh, t, limits).is_ok() {
+            tr.tq[t as usize] = f64::INFINITY;
+            for v in verts {
+                *tr.vert_dirty[v as usize].get_mut() = true;
+            }
+            removed += 1;
+        }
+    }
+    report.caps_removed += removed;
+    removed
 }
 
 /// Boundary smoothing of the dirty surface and line vertices (allowed by

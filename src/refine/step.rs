@@ -160,6 +160,7 @@ pub fn refine_step_with_progress(
                         // no crease, however shallow, is cut.
                         if let Some(b) = &mut io.boundary {
                             b.crease_angle = crate::improve::boundary_smooth::FLAT_ONLY;
+                            b.remove_caps = false;
                         }
                     }
                     report.improve = improve(mesh, &io);

@@ -138,7 +138,6 @@ pub fn copy_cell_field(parents: &[u32], values: &[f64], components: usize) -> Ve
         .collect()
 }
 
-
 /// A uniform grid of cubic cells over a bounding box; item `i` is listed in
 /// every cell its box overlaps.
 struct Grid {

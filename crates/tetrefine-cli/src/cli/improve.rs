@@ -54,7 +54,7 @@ pub fn run(a: Args) -> super::CliResult {
     );
     let after = MeshStats::compute(&mesh);
     crate::say!(
-        "min dihedral worst/avg: {:.2}° / {:.2}° -> {:.2}° / {:.2}°  ({} edges removed, {} Laplacian and {} optimized moves, {} boundary and {} feature-line moves in {} passes)",
+        "min dihedral worst/avg: {:.2}° / {:.2}° -> {:.2}° / {:.2}°  ({} edges removed, {} Laplacian and {} optimized moves, {} boundary and {} feature-line moves, {} boundary caps removed, in {} passes)",
         before.min_dihedral_deg.worst,
         before.min_dihedral_deg.avg,
         after.min_dihedral_deg.worst,
@@ -64,6 +64,7 @@ pub fn run(a: Args) -> super::CliResult {
         report.optimized_moves,
         report.surface_moves,
         report.line_moves,
+        report.caps_removed,
         report.passes
     );
     super::write_mesh(&a.output, &mesh)
