@@ -73,8 +73,11 @@ impl Default for BoundarySmoothOptions {
         BoundarySmoothOptions {
             hausd: None,
             hausd_rel: 0.05,
-            threshold: 0.5,
-            laplacian_threshold: 0.7,
+            // Measured on tripod, gmsh_t16 and getfem_ladder (two steps):
+            // 0.4 / 0.5 keeps the worst angles of 0.5 / 0.7 or better (15.3°,
+            // 15.4°, 12.8° after step 2) at a third to a half of its time.
+            threshold: 0.4,
+            laplacian_threshold: 0.5,
             crease_angle: 45.0,
             remove_caps: true,
         }

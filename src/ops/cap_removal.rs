@@ -84,7 +84,8 @@ pub fn remove_boundary_cap(mesh: &mut TetMesh, t: u32, limits: CapLimits) -> Res
     let normal = |f: &[DVec3; 3]| (f[1] - f[0]).cross(f[2] - f[0]).normalize();
     // Outward normals of the new boundary: TET_FACES lists faces outward.
     let cos = normal(&new[0]).dot(normal(&new[1]));
-    if !(cos >= limits.crease_angle.to_radians().cos()) {
+    // NaN (a degenerate face) refuses as a crease does.
+    if cos.is_nan() || cos < limits.crease_angle.to_radians().cos() {
         return Err(OpError::NotApplicable(
             "the new boundary would have a crease",
         ));
