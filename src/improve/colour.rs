@@ -109,7 +109,6 @@ impl Balls {
     }
 }
 
-#[allow(dead_code)] // TEMP(merge): used by the quality branch's boundary smoothing
 /// Greedy colouring of the balls' vertices `verts` (ball `i` is the ball of
 /// `verts[i]`), visited in order: each takes the smallest colour no earlier
 /// vertex sharing a tet with it has. Returns the colour classes as lists of
@@ -166,7 +165,6 @@ pub fn colour_balls_except(
     all
 }
 
-#[allow(dead_code)] // TEMP(merge): used by the quality branch's boundary smoothing
 /// Colour classes of `verts` (see [`colour_balls`]) as lists of vertex ids:
 /// within a class no two vertices share a tet.
 pub fn colour_classes(mesh: &TetMesh, verts: &[u32]) -> Vec<Vec<u32>> {

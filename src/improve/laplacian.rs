@@ -5,7 +5,7 @@ use super::BallPoints;
 use crate::mesh::TetMesh;
 use glam::DVec3;
 
-/// The ball of a vertex as it stands, for [`laplacian_position`].
+/// The ball of a vertex as it stands, for [`laplacian_position_in`].
 #[derive(Clone, Copy, Debug)]
 pub struct BallNow {
     /// Its worst tet quality.
@@ -17,25 +17,11 @@ pub struct BallNow {
     pub first: usize,
 }
 
-#[allow(dead_code)] // TEMP(merge): used by the quality branch's boundary smoothing
-/// Where [`laplacian_smooth`] would move `v`, without moving it: the
-/// Laplacian target and the ball's new worst quality, if the target raises the
-/// worst quality above `now.worst` without lowering the mean below `now.mean`
-/// or inverting anything. On success `qualities` holds the ball's tet
-/// qualities at the target, in `ball` order.
-pub fn laplacian_position(
-    mesh: &TetMesh,
-    v: u32,
-    ball: &[u32],
-    now: BallNow,
-    qualities: &mut Vec<f64>,
-) -> Option<(DVec3, f64)> {
-    let mut bp = BallPoints::default();
-    bp.load(mesh, v, ball);
-    laplacian_position_in(mesh, v, ball, &bp, now, qualities)
-}
-
-/// [`laplacian_position`] with the ball's corners already loaded in `bp`.
+/// Where the Laplacian move would take `v`, without moving it (the ball's
+/// corners loaded in `bp`): the Laplacian target and the ball's new worst
+/// quality, if the target raises the worst quality above `now.worst` without
+/// lowering the mean below `now.mean` or inverting anything. On success
+/// `qualities` holds the ball's tet qualities at the target, in `ball` order.
 pub fn laplacian_position_in(
     mesh: &TetMesh,
     v: u32,

@@ -4,12 +4,15 @@
 //! The objective everywhere is the paper's quality: the minimum signed sine of
 //! the dihedral angles of a tet, and for a vertex the minimum over its ball.
 
+pub mod boundary_smooth;
 pub mod colour;
+pub mod effort;
 pub mod laplacian;
 pub mod optimize;
 pub mod passes;
 pub mod ring;
 
+pub use effort::Effort;
 pub use passes::{improve, ImproveOptions, ImproveReport};
 
 use crate::geom::{all_positive, tet_min_sine};
@@ -17,8 +20,8 @@ use crate::mesh::TetMesh;
 use glam::DVec3;
 use std::cell::RefCell;
 
-#[allow(dead_code)] // TEMP(merge): used by the quality branch's boundary smoothing
-/// Smallest quality over the tets of `ball` as they stand.
+/// Smallest quality over the tets of `ball` as they stand (tests).
+#[cfg(test)]
 pub fn ball_quality(mesh: &TetMesh, ball: &[u32]) -> f64 {
     ball.iter()
         .map(|&t| tet_min_sine(&mesh.tet_points(t)))

@@ -12,7 +12,6 @@
 //! predicate); otherwise it is halved, a few times, and then the search stops.
 
 use super::BallPoints;
-use crate::mesh::TetMesh;
 use glam::DVec3;
 
 /// Tuning of the optimiser.
@@ -38,7 +37,7 @@ impl Default for OptimizeParams {
 
 /// Minimum-norm point of the convex hull of `g` (a few Gilbert iterations):
 /// a direction along which all active qualities rise, if one exists.
-fn min_norm_in_hull(g: &[DVec3]) -> DVec3 {
+pub(crate) fn min_norm_in_hull(g: &[DVec3]) -> DVec3 {
     let mut x = g[0];
     for _ in 0..32 {
         // Vertex minimising <x, g_i>.
@@ -68,23 +67,9 @@ fn min_norm_in_hull(g: &[DVec3]) -> DVec3 {
     x
 }
 
-#[allow(dead_code)] // TEMP(merge): used by the quality branch's boundary smoothing
-/// Where the optimiser would move `v` if it stood at `x0`, without moving
-/// it: the optimised position and the ball's new minimum quality, if
-/// that is above the minimum at `x0`.
-pub fn optimize_position(
-    mesh: &TetMesh,
-    v: u32,
-    x0: DVec3,
-    ball: &[u32],
-    params: &OptimizeParams,
-) -> Option<(DVec3, f64)> {
-    let mut bp = BallPoints::default();
-    bp.load(mesh, v, ball);
-    optimize_position_in(&bp, x0, params, &mut Vec::new(), &mut Vec::new())
-}
-
-/// [`optimize_position`] with the ball's corners loaded in `bp`. On success
+/// Where the optimiser would move the vertex whose ball's corners are loaded
+/// in `bp` if it stood at `x0`, without moving it: the optimised position and
+/// the ball's new minimum quality, if that is above the minimum at `x0`. On success
 /// `qs` holds the ball's qualities at the new position, in ball order; `trial`
 /// is scratch.
 pub fn optimize_position_in(

@@ -9,6 +9,7 @@
 //! (closed rings inside one region) are removed, so the domain, its regions
 //! and its tags are untouched.
 
+use super::boundary_smooth::{BoundarySmoothOptions, BoundarySmoothReport, BoundarySmoother};
 use super::colour::{colour_balls_except, sequential_levels, Balls};
 use super::laplacian::{laplacian_position_in, BallNow};
 use super::optimize::{optimize_position_in, OptimizeParams};
@@ -20,6 +21,7 @@ use crate::mesh::{edge_key, EdgeKey, TetMesh};
 use crate::ops::edge_removal::{apply_ring_triangulation, RingTriangulation};
 use crate::ops::edge_removal::{best_ring_triangulation_above, RingScratch};
 use crate::ops::EdgeRing;
+use crate::ops::{is_cap_below, remove_boundary_cap, CapLimits};
 use crate::topo::scatter::Shared;
 use crate::topo::{EDGE_OF, TET_EDGES};
 use glam::DVec3;
@@ -52,6 +54,9 @@ pub struct ImproveOptions {
     /// are gathered at once, about 90 bytes a vertex, and each block costs a
     /// scan over the tet slots.
     pub smooth_block: usize,
+    /// Boundary and interface vertices smoothed inside their patch
+    /// ([`super::boundary_smooth`]); `None`: the boundary stays fixed.
+    pub boundary: Option<BoundarySmoothOptions>,
 }
 
 impl Default for ImproveOptions {
@@ -65,6 +70,7 @@ impl Default for ImproveOptions {
             movable: None,
             tet_allowed: None,
             smooth_block: 1 << 20,
+            boundary: Some(BoundarySmoothOptions::default()),
         }
     }
 }
@@ -80,6 +86,12 @@ pub struct ImproveReport {
     pub laplacian_moves: usize,
     /// Vertices moved by optimization-based smoothing.
     pub optimized_moves: usize,
+    /// Boundary and interface vertices moved inside their patch.
+    pub surface_moves: usize,
+    /// Feature-line vertices moved along their line.
+    pub line_moves: usize,
+    /// Boundary sliver caps removed ([`crate::ops::remove_boundary_cap`]).
+    pub caps_removed: usize,
 }
 
 /// Work-tracking state of [`improve`]: per-slot quality and dirty flags, so
@@ -169,15 +181,127 @@ pub fn improve(mesh: &mut TetMesh, opts: &ImproveOptions) -> ImproveReport {
     let mut report = ImproveReport::default();
     let mut tr = Tracker::new(mesh, opts.tet_allowed.clone());
     let mut edges = EdgeRemoval::default();
+    // Caps go before the smoother takes the boundary as its reference, and
+    // again after the passes for those the passes left.
+    if let Some(b) = &opts.boundary {
+        cap_pass(mesh, &mut tr, b, opts, &mut report);
+    }
+    let surface = opts
+        .boundary
+        .as_ref()
+        .map(|b| BoundarySmoother::new(mesh, b.clone()));
     for _ in 0..opts.passes {
         report.passes += 1;
         let mut changed = edges.pass(mesh, &mut tr, opts, &mut report);
         changed += smooth_pass(mesh, &mut tr, &movable, opts, &mut report);
+        if let Some(s) = &surface {
+            changed += boundary_pass(mesh, &mut tr, s, opts, &mut report);
+        }
         if changed == 0 {
             break;
         }
     }
+    if let Some(b) = &opts.boundary {
+        if opts.passes > 0 {
+            cap_pass(mesh, &mut tr, b, opts, &mut report);
+        }
+    }
     report
+}
+
+/// Removes the boundary caps (tets with two boundary faces) below
+/// `opts.threshold` that may go under the Hausdorff bound of `b` (absolute,
+/// or relative to the cap's mean edge length), one by one in slot order.
+/// Returns the number removed.
+fn cap_pass(
+    mesh: &mut TetMesh,
+    tr: &mut Tracker,
+    b: &BoundarySmoothOptions,
+    opts: &ImproveOptions,
+    report: &mut ImproveReport,
+) -> usize {
+    if !b.remove_caps {
+        return 0;
+    }
+    let candidates: Vec<u32> = (0..mesh.n_tet_slots() as u32)
+        .filter(|&t| {
+            mesh.is_alive(t)
+                && tr.tq[t as usize] < opts.threshold
+                && tr.is_allowed(t)
+                && is_cap_below(mesh, t, opts.threshold)
+        })
+        .collect();
+    let mut removed = 0;
+    for t in candidates {
+        let p = mesh.tet_points(t);
+        let mean_edge = crate::topo::TET_EDGES
+            .iter()
+            .map(|e| p[e[0]].distance(p[e[1]]))
+            .sum::<f64>()
+            / 6.0;
+        let limits = CapLimits {
+            hausd: b.hausd.unwrap_or(b.hausd_rel * mean_edge),
+            crease_angle: b.crease_angle,
+        };
+        let verts = mesh.tet(t);
+        if remove_boundary_cap(mesh, t, limits).is_ok() {
+            tr.tq[t as usize] = f64::INFINITY;
+            for v in verts {
+                *tr.vert_dirty[v as usize].get_mut() = true;
+            }
+            removed += 1;
+        }
+    }
+    report.caps_removed += removed;
+    removed
+}
+
+/// Boundary smoothing of the dirty surface and line vertices (allowed by
+/// `opts.movable`) whose worst tet is below the Laplacian bar, one by one in
+/// vertex order. Returns the number of vertices moved.
+fn boundary_pass(
+    mesh: &mut TetMesh,
+    tr: &mut Tracker,
+    s: &BoundarySmoother,
+    opts: &ImproveOptions,
+    report: &mut ImproveReport,
+) -> usize {
+    let bar = opts.threshold.max(opts.laplacian_threshold);
+    let mut vq = vec![f64::INFINITY; mesh.n_points()];
+    for (t, tv) in mesh.tet_slots().iter().enumerate() {
+        let q = tr.tq[t];
+        if q.is_finite() && mesh.is_alive(t as u32) {
+            for &x in tv {
+                let s = &mut vq[x as usize];
+                *s = s.min(q);
+            }
+        }
+    }
+    let verts: Vec<u32> = s
+        .movable_vertices()
+        .into_iter()
+        .filter(|&v| {
+            let dirty = tr.vert_dirty[v as usize].get_mut();
+            let take = *dirty
+                && vq[v as usize] < bar
+                && opts
+                    .movable
+                    .as_ref()
+                    .is_none_or(|m| m.get(v as usize).copied().unwrap_or(false));
+            if take {
+                *dirty = false;
+            }
+            take
+        })
+        .collect();
+    let mut r = BoundarySmoothReport::default();
+    let changed = s.pass(mesh, &verts, &mut r);
+    for (t, q) in changed {
+        tr.set(mesh, t, q);
+    }
+    report.surface_moves += r.surface_moves;
+    report.line_moves += r.line_moves;
+    r.surface_moves + r.line_moves
 }
 
 /// A removable edge found by the search half of an edge removal pass: the

@@ -507,6 +507,36 @@ impl TetMesh {
         self.free.push(t);
     }
 
+    /// Removes tet `t` and opens the mesh there: each neighbour's face that
+    /// `t` shared becomes a boundary face of that neighbour (adjacency stays
+    /// mutual), and a vertex whose `v2t` entry was `t` is re-pointed at a
+    /// neighbour holding it. Every vertex of `t` must lie in a neighbour
+    /// across one of its faces (the caller checks; a vertex left in no tet
+    /// would be orphaned).
+    pub(crate) fn remove_tet_opening(&mut self, t: u32) {
+        let v = self.tet(t);
+        let adj = self.adj(t);
+        for &h in &adj {
+            if h != NO_ADJ {
+                self.bond(h, NO_ADJ);
+            }
+        }
+        for x in v {
+            if self.v2t[x as usize] == t {
+                let holder = adj
+                    .iter()
+                    .filter(|&&h| h != NO_ADJ)
+                    .map(|&h| h >> 2)
+                    .find(|&u| self.tets[u as usize].contains(&x))
+                    .expect(
+                        "remove_tet_opening: every vertex lies in a neighbour (caller's check)",
+                    );
+                self.v2t[x as usize] = holder;
+            }
+        }
+        self.kill_tet(t);
+    }
+
     /// Reserves room for `n` more tets and `p` more points.
     pub fn reserve(&mut self, n: usize, p: usize) {
         self.tets.reserve(n);

@@ -141,6 +141,11 @@ pub struct RefineOptions {
     /// Run [`TetMesh::check`](crate::TetMesh::check) after every phase and
     /// record failures in [`StepReport::check_failures`] (tests, debugging).
     pub check_each_phase: bool,
+    /// How hard the optimize phase works (`--effort`).
+    pub effort: crate::improve::Effort,
+    /// Hausdorff bound of boundary moves (`--hausd`; `None`: relative to the
+    /// local edge length).
+    pub hausd: Option<f64>,
 }
 
 impl Default for RefineOptions {
@@ -154,6 +159,8 @@ impl Default for RefineOptions {
             smooth_refined_only: false,
             step_offset: 0,
             check_each_phase: false,
+            effort: crate::improve::Effort::Default,
+            hausd: None,
         }
     }
 }

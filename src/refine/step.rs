@@ -147,16 +147,23 @@ pub fn refine_step_with_progress(
                     } else {
                         (None, None)
                     };
-                    report.improve = improve(
-                        mesh,
-                        &ImproveOptions {
-                            passes: opts.opt_passes,
-                            threshold: opts.threshold,
-                            movable,
-                            tet_allowed,
-                            ..Default::default()
-                        },
-                    );
+                    let mut io = ImproveOptions {
+                        movable,
+                        tet_allowed,
+                        ..opts
+                            .effort
+                            .improve_options(opts.opt_passes, opts.threshold, opts.hausd)
+                    };
+                    if matches!(opts.boundary, crate::stencil::Sqrt3Rule::Linear) {
+                        // The linear rule promises the input's domain: a
+                        // boundary vertex moves only inside a flat star, so
+                        // no crease, however shallow, is cut.
+                        if let Some(b) = &mut io.boundary {
+                            b.crease_angle = crate::improve::boundary_smooth::FLAT_ONLY;
+                            b.remove_caps = false;
+                        }
+                    }
+                    report.improve = improve(mesh, &io);
                 }
             }
         }

@@ -23,7 +23,7 @@
 //!   (the input tet that holds its centroid, [`super::locate_parents`]).
 
 use super::parents::{contains, walk_to};
-use crate::geom::orient3d;
+use crate::geom::{closest_point_on_triangle, orient3d};
 use crate::mesh::TetMesh;
 use crate::topo::TET_FACES;
 use glam::DVec3;
@@ -136,51 +136,6 @@ pub fn copy_cell_field(parents: &[u32], values: &[f64], components: usize) -> Ve
         .iter()
         .flat_map(|&p| values[p as usize * c..(p as usize + 1) * c].iter().copied())
         .collect()
-}
-
-/// The closest point to `p` of the triangle `(a, b, c)` and its barycentric
-/// coordinates — Ericson, *Real-Time Collision Detection* (2005), §5.1.5,
-/// by Voronoi regions of the vertices, edges and face.
-pub fn closest_point_on_triangle(p: DVec3, a: DVec3, b: DVec3, c: DVec3) -> (DVec3, [f64; 3]) {
-    let ab = b - a;
-    let ac = c - a;
-    let ap = p - a;
-    let d1 = ab.dot(ap);
-    let d2 = ac.dot(ap);
-    if d1 <= 0.0 && d2 <= 0.0 {
-        return (a, [1.0, 0.0, 0.0]);
-    }
-    let bp = p - b;
-    let d3 = ab.dot(bp);
-    let d4 = ac.dot(bp);
-    if d3 >= 0.0 && d4 <= d3 {
-        return (b, [0.0, 1.0, 0.0]);
-    }
-    let vc = d1 * d4 - d3 * d2;
-    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
-        let v = d1 / (d1 - d3);
-        return (a + v * ab, [1.0 - v, v, 0.0]);
-    }
-    let cp = p - c;
-    let d5 = ab.dot(cp);
-    let d6 = ac.dot(cp);
-    if d6 >= 0.0 && d5 <= d6 {
-        return (c, [0.0, 0.0, 1.0]);
-    }
-    let vb = d5 * d2 - d1 * d6;
-    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
-        let w = d2 / (d2 - d6);
-        return (a + w * ac, [1.0 - w, 0.0, w]);
-    }
-    let va = d3 * d6 - d5 * d4;
-    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
-        let w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
-        return (b + w * (c - b), [0.0, 1.0 - w, w]);
-    }
-    let denom = 1.0 / (va + vb + vc);
-    let v = vb * denom;
-    let w = vc * denom;
-    (a + ab * v + ac * w, [1.0 - v - w, v, w])
 }
 
 /// A uniform grid of cubic cells over a bounding box; item `i` is listed in
@@ -421,19 +376,6 @@ impl BoundaryFaces {
 mod tests {
     use super::*;
     use crate::mesh::generate::cube_grid;
-
-    #[test]
-    fn closest_point_regions() {
-        let (a, b, c) = (DVec3::ZERO, DVec3::X, DVec3::Y);
-        let (q, w) = closest_point_on_triangle(DVec3::new(0.25, 0.25, 3.0), a, b, c);
-        assert!((q - DVec3::new(0.25, 0.25, 0.0)).length() < 1e-15);
-        assert!((w[0] - 0.5).abs() < 1e-15);
-        let (q, _) = closest_point_on_triangle(DVec3::new(-1.0, -1.0, 0.0), a, b, c);
-        assert_eq!(q, a);
-        let (q, w) = closest_point_on_triangle(DVec3::new(1.0, 1.0, 0.0), a, b, c);
-        assert!((q - DVec3::new(0.5, 0.5, 0.0)).length() < 1e-15);
-        assert!((w[1] - 0.5).abs() < 1e-15 && (w[2] - 0.5).abs() < 1e-15);
-    }
 
     #[test]
     fn points_are_found_inside_and_projected_outside() {

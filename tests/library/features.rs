@@ -187,8 +187,11 @@ fn feature_edges_are_kept_in_step_1_and_trisected_in_step_2() {
             }
         };
         let set0: HashSet<_> = segs0.iter().map(key).collect();
+        // The crease rule of the step itself: `fast` keeps the optimize
+        // phase from sliding feature-line vertices along their lines.
         let opts = RefineOptions {
             boundary: Sqrt3Rule::Linear,
+            effort: tetrefine::Effort::Fast,
             ..Default::default()
         };
         refine_step(&mut m, 1, &opts);
@@ -301,22 +304,62 @@ fn tripod_features_match_the_independent_count_and_stay_put() {
     }
     let mut m = load("tripod.mesh");
     detect_features(&mut m, 69.0);
-    let on_feature: Vec<DVec3> = {
-        let mut v: Vec<u32> = m.feature_edges().keys().flatten().copied().collect();
-        v.sort_unstable();
-        v.dedup();
-        v.iter().map(|&x| m.point(x)).collect()
-    };
+    // The input's feature polyline and corners, before any step.
+    let polyline = feature_segments(&m);
+    let corners: Vec<DVec3> = m.corners().iter().map(|&v| m.point(v)).collect();
+    assert!(!corners.is_empty());
+    let (lo, hi) = m.tet_ids().flat_map(|t| m.tet_points(t)).fold(
+        (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
+        |(lo, hi), p| (lo.min(p), hi.max(p)),
+    );
+    let diag = (hi - lo).length();
+    let shortest = m
+        .tet_ids()
+        .flat_map(|t| {
+            let p = m.tet_points(t);
+            [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)].map(|(i, j)| (p[i] - p[j]).length())
+        })
+        .fold(f64::INFINITY, f64::min);
+    assert!(
+        1e-10 * diag < 1e-6 * shortest,
+        "diag {diag}, shortest edge {shortest}"
+    );
     two_steps(&mut m, Sqrt3Rule::Interpolating);
-    let mut feature_points: HashSet<[u64; 3]> = HashSet::new();
+    // Feature edges are kept in step 1 and trisected in step 2: 3 × 294.
+    assert_eq!(m.feature_edges().len(), 3 * 294);
+    // Feature-line vertices may slide (boundary smoothing moves them along
+    // their line), but only along the input polyline. Every such point is
+    // computed as a + s·(b − a) from the input's endpoints (trisection and
+    // the projection of a slide), which rounds by a few ulps of the
+    // coordinates (|x| ≤ diag, ulp ≈ 2.2e-16·diag); 1e-10·diag leaves a
+    // margin of about a million over that and is still far below the
+    // shortest input edge (checked below), so a point that left its line by
+    // any visible amount fails.
+    let tol = 1e-10 * diag;
+    let dist = |p: DVec3| {
+        polyline
+            .iter()
+            .map(|s| {
+                let d = s[1] - s[0];
+                let u = ((p - s[0]).dot(d) / d.length_squared()).clamp(0.0, 1.0);
+                (p - (s[0] + u * d)).length()
+            })
+            .fold(f64::INFINITY, f64::min)
+    };
     for e in m.feature_edges().keys() {
-        feature_points.insert(bits(m.point(e[0])));
-        feature_points.insert(bits(m.point(e[1])));
+        for &v in e {
+            let p = m.point(v);
+            let d = dist(p);
+            assert!(
+                d <= tol,
+                "feature vertex {v} at {p} is {d:e} off the input polyline (tol {tol:e})"
+            );
+        }
     }
-    for p in on_feature {
-        assert!(
-            feature_points.contains(&bits(p)),
-            "feature vertex {p} left its feature"
-        );
+    // Corners never move: each input corner is still a corner, bit for bit.
+    let out_corners: HashSet<[u64; 3]> = m.corners().iter().map(|&v| bits(m.point(v))).collect();
+    assert_eq!(m.corners().len(), corners.len());
+    for p in corners {
+        assert!(out_corners.contains(&bits(p)), "corner {p} moved");
     }
 }

@@ -11,6 +11,7 @@ mod features;
 mod improve_parallel;
 mod marking;
 mod ops_proptest;
+mod quality_guarantees;
 mod refine_counts;
 mod refine_meshes;
 mod refine_quality;

@@ -1,5 +1,6 @@
-//! `tetrefine improve IN -o OUT [--opt-passes N]`: the optimize phase alone,
-//! boundary fixed — a mesh clean-up tool.
+//! `tetrefine improve IN -o OUT [--opt-passes N] [--effort E] [--hausd D]`:
+//! the optimize phase alone — a mesh clean-up tool; boundary vertices move
+//! inside their patches (corners and feature lines kept) unless `--effort fast`.
 
 use std::path::PathBuf;
 use tetrefine::MeshStats;
@@ -21,6 +22,21 @@ pub struct Args {
     /// from the tet count and a mesh that would not fit is refused.
     #[arg(long, value_name = "SIZE")]
     pub max_memory: Option<String>,
+    /// fast (boundary fixed), default (boundary vertices move inside their
+    /// patch and along feature lines), best.
+    #[arg(long, default_value = "default")]
+    pub effort: tetrefine::Effort,
+    /// Hausdorff bound of boundary moves (MMG's -hausd); default 5 % of
+    /// the local edge length.
+    #[arg(long)]
+    pub hausd: Option<f64>,
+    /// Sharp features: auto (input tags plus detected creases and patch
+    /// borders, kept in place), none, or an edge-list file.
+    #[arg(long, default_value = "auto")]
+    pub features: String,
+    /// Crease angle for --features auto (degrees).
+    #[arg(long, default_value_t = 45.0)]
+    pub feature_angle: f64,
 }
 
 /// Runs `improve`.
@@ -29,17 +45,16 @@ pub fn run(a: Args) -> super::CliResult {
     let budget = super::guard::MemoryBudget::new(a.max_memory.as_deref())?;
     let mut mesh = super::load(&a.input)?;
     budget.check_improve(mesh.n_tets() as u64)?;
+    super::apply_feature_option(&mut mesh, &a.features, a.feature_angle)?;
     let before = MeshStats::compute(&mesh);
     let report = improve(
         &mut mesh,
-        &ImproveOptions {
-            passes: a.opt_passes,
-            ..Default::default()
-        },
+        &a.effort
+            .improve_options(a.opt_passes, ImproveOptions::default().threshold, a.hausd),
     );
     let after = MeshStats::compute(&mesh);
     crate::say!(
-        "min dihedral worst/avg: {:.2}° / {:.2}° -> {:.2}° / {:.2}°  ({} edges removed, {} Laplacian and {} optimized moves in {} passes)",
+        "min dihedral worst/avg: {:.2}° / {:.2}° -> {:.2}° / {:.2}°  ({} edges removed, {} Laplacian and {} optimized moves, {} boundary and {} feature-line moves, {} boundary caps removed, in {} passes)",
         before.min_dihedral_deg.worst,
         before.min_dihedral_deg.avg,
         after.min_dihedral_deg.worst,
@@ -47,6 +62,9 @@ pub fn run(a: Args) -> super::CliResult {
         report.edges_removed,
         report.laplacian_moves,
         report.optimized_moves,
+        report.surface_moves,
+        report.line_moves,
+        report.caps_removed,
         report.passes
     );
     super::write_mesh(&a.output, &mesh)

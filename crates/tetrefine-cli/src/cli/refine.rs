@@ -56,6 +56,16 @@ pub struct Args {
     /// Minimum-sine quality below which vertices get optimization-based smoothing.
     #[arg(long, default_value_t = 0.3)]
     pub threshold: f64,
+    /// How hard the optimize phase works: fast (boundary fixed), default
+    /// (boundary vertices move inside their patch and along feature lines),
+    /// best (more passes, larger edge-removal rings, a higher bar).
+    #[arg(long, default_value = "default")]
+    pub effort: tetrefine::Effort,
+    /// Hausdorff bound (MMG's -hausd): how far boundary moves may take the
+    /// surface from the step's reference surface; default 5 % of the local
+    /// edge length.
+    #[arg(long)]
+    pub hausd: Option<f64>,
     /// Stop each step after this phase: split, flip, boundary-split,
     /// boundary-flip, boundary-smooth, optimize.
     #[arg(long)]
@@ -252,6 +262,11 @@ pub fn run(a: Args) -> super::CliResult {
     if let Some(f) = &a.features_out {
         tetrefine::PolylineFormat::of(f).map_err(|e| e.to_string())?;
     }
+    if let Some(h) = a.hausd {
+        if !(h >= 0.0 && h.is_finite()) {
+            return Err(format!("--hausd {h} must be a finite distance >= 0"));
+        }
+    }
     let strategy = mark_strategy(&a)?;
     let (mut input, mut meta) = super::load_with_meta(&a.input)?;
     for f in &a.fields {
@@ -344,6 +359,8 @@ pub fn run(a: Args) -> super::CliResult {
         smooth_refined_only: selection.is_some() && a.smooth == SmoothScope::Refined,
         step_offset: a.step_offset,
         check_each_phase: false,
+        effort: a.effort,
+        hausd: a.hausd,
     };
     let t0 = Instant::now();
     let first = MeshStats::compute(&mesh);

@@ -1,0 +1,111 @@
+//! `--effort fast|default|best`: how hard the optimize phase works, as a
+//! preset of [`ImproveOptions`].
+
+use super::boundary_smooth::BoundarySmoothOptions;
+use super::passes::ImproveOptions;
+use std::fmt;
+use std::str::FromStr;
+
+/// How hard mesh improvement works.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Effort {
+    /// Interior moves and edge removal only (the boundary stays fixed): the
+    /// behaviour before boundary-aware improvement.
+    Fast,
+    /// Interior and boundary moves (surface patches, feature lines).
+    #[default]
+    Default,
+    /// More passes, a higher bar for optimisation-based smoothing, edge
+    /// removal over larger rings and better tets.
+    Best,
+}
+
+impl Effort {
+    /// The improvement options of this effort with `passes` passes (the
+    /// user's `--opt-passes`), optimisation below `threshold` (min sine) and
+    /// Hausdorff bound `hausd` (`None`: relative to the local edge length).
+    pub fn improve_options(
+        self,
+        passes: usize,
+        threshold: f64,
+        hausd: Option<f64>,
+    ) -> ImproveOptions {
+        let base = ImproveOptions {
+            passes,
+            threshold,
+            ..Default::default()
+        };
+        match self {
+            Effort::Fast => ImproveOptions {
+                boundary: None,
+                ..base
+            },
+            Effort::Default => ImproveOptions {
+                boundary: Some(BoundarySmoothOptions {
+                    hausd,
+                    ..Default::default()
+                }),
+                ..base
+            },
+            Effort::Best => ImproveOptions {
+                passes: passes.max(6),
+                threshold: threshold.max(0.45),
+                edge_threshold: 0.7,
+                max_ring: 24,
+                boundary: Some(BoundarySmoothOptions {
+                    hausd,
+                    threshold: 0.6,
+                    laplacian_threshold: 0.8,
+                    ..Default::default()
+                }),
+                ..base
+            },
+        }
+    }
+
+    /// The name on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            Effort::Fast => "fast",
+            Effort::Default => "default",
+            Effort::Best => "best",
+        }
+    }
+}
+
+impl fmt::Display for Effort {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl FromStr for Effort {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Effort, String> {
+        match s {
+            "fast" => Ok(Effort::Fast),
+            "default" => Ok(Effort::Default),
+            "best" => Ok(Effort::Best),
+            _ => Err(format!("unknown effort '{s}'; one of fast, default, best")),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn presets_order_the_work() {
+        let f = Effort::Fast.improve_options(3, 0.3, None);
+        let d = Effort::Default.improve_options(3, 0.3, Some(0.01));
+        let b = Effort::Best.improve_options(3, 0.3, None);
+        assert!(f.boundary.is_none());
+        assert_eq!(d.boundary.as_ref().and_then(|o| o.hausd), Some(0.01));
+        assert!(b.passes > d.passes && b.max_ring > d.max_ring && b.threshold > d.threshold);
+        for e in ["fast", "default", "best"] {
+            assert_eq!(e.parse::<Effort>().unwrap().name(), e);
+        }
+        assert!("most".parse::<Effort>().is_err());
+    }
+}
