@@ -277,6 +277,10 @@ pub struct RefineArgs {
     pub allow_empty: bool,
     /// `--allow-steps-zero`: `steps = 0` is not an error.
     pub allow_steps_zero: bool,
+    /// `--effort fast|default|best`.
+    pub effort: String,
+    /// `--hausd`.
+    pub hausd: Option<f64>,
     /// `--steps auto` (then `steps` is the cap, [`AUTO_SIZE_PASSES`]).
     pub steps_auto: bool,
     /// `--size` / `--size-array`: components (1 or 6) and values per point.
@@ -568,6 +572,16 @@ pub fn refine(
         smooth_refined_only: selection.is_some() && a.smooth_refined,
         step_offset: a.step_offset,
         check_each_phase: false,
+        effort: a
+            .effort
+            .parse::<tetrefine::Effort>()
+            .map_err(|e| Value(format!("effort={:?}: {e}", a.effort)))?,
+        hausd: match a.hausd {
+            Some(h) if !(h.is_finite() && h >= 0.0) => {
+                return Err(Value(format!("hausd={h} must be a finite distance >= 0")))
+            }
+            h => h,
+        },
     };
     let progress = HookProgress {
         hook,
@@ -729,23 +743,49 @@ pub fn locate(
 
 /// `tetrefine improve`: edge removal and smoothing, boundary fixed, on a
 /// copy; the report as JSON.
-pub fn improve(
-    input: &TetMesh,
-    passes: usize,
-    threshold: f64,
-) -> Result<(TetMesh, String), String> {
-    use tetrefine::{improve, ImproveOptions};
+/// The options of [`improve`], as `tetrefine improve` takes them.
+pub struct ImproveArgs {
+    /// `--opt-passes`.
+    pub passes: usize,
+    /// Optimisation bar (min sine).
+    pub threshold: f64,
+    /// `--effort`.
+    pub effort: String,
+    /// `--hausd`.
+    pub hausd: Option<f64>,
+    /// `--features auto|none`.
+    pub features: String,
+    /// `--feature-angle`.
+    pub feature_angle: f64,
+}
+
+/// `tetrefine improve`: features as `--features` says, then the optimize
+/// phase at the given effort.
+pub fn improve(input: &TetMesh, a: &ImproveArgs) -> Result<(TetMesh, String), String> {
+    let threshold = a.threshold;
     if !(threshold > 0.0 && threshold < 1.0) {
         return Err(format!("threshold={threshold} must lie in (0, 1) (a sine)"));
     }
+    let effort: tetrefine::Effort = a
+        .effort
+        .parse()
+        .map_err(|e| format!("effort={:?}: {e}", a.effort))?;
+    if let Some(h) = a.hausd {
+        if !(h.is_finite() && h >= 0.0) {
+            return Err(format!("hausd={h} must be a finite distance >= 0"));
+        }
+    }
     let mut mesh = input.clone();
-    let report = improve(
+    match a.features.as_str() {
+        "none" => mesh.clear_features(),
+        "auto" => {
+            tetrefine::detect_features(&mut mesh, a.feature_angle);
+        }
+        other => return Err(format!("features={other:?}: use 'auto' or 'none'")),
+    }
+    let report = tetrefine::improve(
         &mut mesh,
-        &ImproveOptions {
-            passes,
-            threshold,
-            ..Default::default()
-        },
+        &effort.improve_options(a.passes, threshold, a.hausd),
     );
     mesh.compact();
     Ok((mesh, serde_json::to_string(&report).unwrap_or_default()))

@@ -684,6 +684,11 @@ impl Mesh {
     ///   hsiz          One target edge length everywhere [--hsiz].
     ///   hmax          The largest target edge length: caps size or hsiz,
     ///                 or alone is the size map [--hmax].
+    ///   effort        'fast' (boundary fixed), 'default' (boundary vertices
+    ///                 move inside their patch and along feature lines,
+    ///                 sliver caps removed) or 'best' [--effort].
+    ///   hausd         Hausdorff bound of boundary moves (MMG's -hausd);
+    ///                 None: 5 % of the local edge length [--hausd].
     ///
     /// The GIL is released while the mesh is refined. Ctrl-C (SIGINT) stops
     /// the run at the start of the next phase and raises KeyboardInterrupt.
@@ -695,8 +700,9 @@ impl Mesh {
                      mark=None, region=None, r#box=None, sphere=None, smooth="refined",
                      step_offset=0, progress=None, stats=false, allow_empty=false,
                      allow_steps_zero=false, point_fields=None, cell_fields=None,
-                     transfer=None, vertex_parents=false, size=None, hsiz=None, hmax=None),
-        text_signature = "(self, steps=None, *, boundary='interpolating', opt_passes=3, threshold=0.3, stop_after=None, features='auto', feature_angle=45.0, indicator=None, mark='doerfler:0.5', region=None, box=None, sphere=None, smooth='refined', step_offset=0, progress=False, stats=False, allow_empty=False, allow_steps_zero=False, point_fields=None, cell_fields=None, transfer=None, vertex_parents=False, size=None, hsiz=None, hmax=None)"
+                     transfer=None, vertex_parents=false, size=None, hsiz=None, hmax=None,
+                     effort="default", hausd=None),
+        text_signature = "(self, steps=None, *, boundary='interpolating', opt_passes=3, threshold=0.3, stop_after=None, features='auto', feature_angle=45.0, indicator=None, mark='doerfler:0.5', region=None, box=None, sphere=None, smooth='refined', step_offset=0, progress=False, stats=False, allow_empty=False, allow_steps_zero=False, point_fields=None, cell_fields=None, transfer=None, vertex_parents=False, size=None, hsiz=None, hmax=None, effort='default', hausd=None)"
     )]
     #[allow(clippy::too_many_arguments)]
     fn refine(
@@ -727,6 +733,8 @@ impl Mesh {
         size: Option<&Bound<'_, PyAny>>,
         hsiz: Option<f64>,
         hmax: Option<f64>,
+        effort: &str,
+        hausd: Option<f64>,
     ) -> PyResult<Mesh> {
         let this = slf.get();
         let size = match size {
@@ -806,6 +814,8 @@ impl Mesh {
             cell_fields,
             transfer: transfer.unwrap_or(has_fields),
             vertex_parents,
+            effort: effort.to_string(),
+            hausd,
         };
         // progress: None/False, True (lines on stderr) or a callable.
         let (print, callback): (bool, Option<Py<PyAny>>) = match progress {
@@ -863,18 +873,45 @@ impl Mesh {
         }
     }
 
-    /// Improve the mesh (edge removal and smoothing), boundary fixed —
-    /// `tetrefine improve`. Returns a new Mesh whose `reports` hold one dict
-    /// (passes, edges_removed, laplacian_moves, optimized_moves).
+    /// Improve the mesh (edge removal, smoothing, boundary moves inside their
+    /// patches and sliver-cap removal; features detected at feature_angle as
+    /// `--features auto` does) — `tetrefine improve`. Returns a new Mesh whose
+    /// `reports` hold one dict (passes, edges_removed, laplacian_moves,
+    /// optimized_moves, surface_moves, line_moves, caps_removed).
     ///
-    ///   opt_passes  Maximum passes of edge removal + smoothing
-    ///               [--opt-passes] (default 5).
-    ///   threshold   Minimum-sine quality below which vertices get
-    ///               optimization-based smoothing (0.3).
-    #[pyo3(signature = (opt_passes=5, *, threshold=0.3))]
-    fn improve(&self, py: Python<'_>, opt_passes: usize, threshold: f64) -> PyResult<Mesh> {
+    ///   opt_passes     Maximum passes of edge removal + smoothing
+    ///                  [--opt-passes] (default 5).
+    ///   threshold      Minimum-sine quality below which vertices get
+    ///                  optimization-based smoothing (0.3).
+    ///   effort         'fast' (boundary fixed), 'default' or 'best'
+    ///                  [--effort].
+    ///   hausd          Hausdorff bound of boundary moves; None: 5 % of the
+    ///                  local edge length [--hausd].
+    ///   features       'auto' or 'none' [--features].
+    ///   feature_angle  Crease angle for 'auto', degrees [--feature-angle].
+    #[pyo3(signature = (opt_passes=5, *, threshold=0.3, effort="default", hausd=None,
+                        features="auto", feature_angle=45.0))]
+    #[allow(clippy::too_many_arguments)]
+    fn improve(
+        &self,
+        py: Python<'_>,
+        opt_passes: usize,
+        threshold: f64,
+        effort: &str,
+        hausd: Option<f64>,
+        features: &str,
+        feature_angle: f64,
+    ) -> PyResult<Mesh> {
         let mesh = &self.inner;
-        let (m, report) = run_core(py, None, || core_api::improve(mesh, opt_passes, threshold))?
+        let args = core_api::ImproveArgs {
+            passes: opt_passes,
+            threshold,
+            effort: effort.to_string(),
+            hausd,
+            features: features.to_string(),
+            feature_angle,
+        };
+        let (m, report) = run_core(py, None, || core_api::improve(mesh, &args))?
             .map_err(PyValueError::new_err)?;
         Ok(Mesh::made(
             m,

@@ -157,8 +157,19 @@ class Mesh:
         size: _Reals | None = None,
         hsiz: float | None = None,
         hmax: float | None = None,
+        effort: str = "default",
+        hausd: float | None = None,
     ) -> Mesh: ...
-    def improve(self, opt_passes: int = 5, *, threshold: float = 0.3) -> Mesh: ...
+    def improve(
+        self,
+        opt_passes: int = 5,
+        *,
+        threshold: float = 0.3,
+        effort: str = "default",
+        hausd: float | None = None,
+        features: str = "auto",
+        feature_angle: float = 45.0,
+    ) -> Mesh: ...
     def bisect(self, steps: int = 1) -> Mesh: ...
     def to_meshio(self, faces: bool = True) -> Any:
         """A meshio.Mesh (needs meshio)."""
