@@ -85,9 +85,9 @@ impl Default for BoundarySmoothOptions {
 }
 
 /// A [`BoundarySmoothOptions::crease_angle`] that lets only vertices of
-/// flat stars move. Coplanar input faces have normals equal up to the
-/// rounding of a normalized cross product (some 1e-15 in the cosine);
-/// 1e-4° is 1.5e-12 in the cosine, well above that and far below any real
+/// flat stars move: at or below it, a star counts as flat only when all its
+/// corners are coplanar by the exact `orient3d` (so no tolerance can let a
+/// vertex leave the domain); the value itself, 1e-4°, is far below any real
 /// crease.
 pub const FLAT_ONLY: f64 = 1e-4;
 
@@ -186,6 +186,22 @@ fn straight(a: DVec3, v: DVec3, b: DVec3) -> bool {
 /// the test uses the unsigned angle between the normals' lines, and a fold
 /// sharper than 180° − `angle` counts as a crease too.
 fn star_has_crease(mesh: &TetMesh, faces: &[[u32; 3]], fs: &[u32], v: u32, angle: f64) -> bool {
+    if angle <= FLAT_ONLY {
+        // Flat stars only: every corner of the star in the plane of its
+        // first face, by the exact orient3d. A tolerance on normals would
+        // let a vertex slide over a patch that bends by 1e-6 radians and
+        // leave the domain by that much (fields carried over by the linear
+        // rule must come back to round-off).
+        let Some(&f0) = fs.first() else {
+            return false;
+        };
+        let [a, b, c] = faces[f0 as usize].map(|u| mesh.point(u));
+        return fs.iter().any(|&f| {
+            faces[f as usize]
+                .iter()
+                .any(|&u| crate::geom::orient3d(a, b, c, mesh.point(u)) != 0.0)
+        });
+    }
     let cos_bar = angle.to_radians().cos();
     let normal = |f: u32| {
         let p = faces[f as usize].map(|u| mesh.point(u));
@@ -281,7 +297,13 @@ impl BoundarySmoother {
             kind[v as usize] = if mesh.is_corner(v) || mesh.is_required(v) {
                 Kind::Fixed
             } else if let Some(nb) = line_nbrs.get(&v) {
-                if nb.len() == 2 && straight(mesh.point(nb[0]), mesh.point(v), mesh.point(nb[1])) {
+                // Under the linear rule (flat stars only) a line vertex stays:
+                // the patches on either side of its line may be curved, and
+                // sliding would then move their faces off the input surface.
+                if nb.len() == 2
+                    && opts.crease_angle > FLAT_ONLY
+                    && straight(mesh.point(nb[0]), mesh.point(v), mesh.point(nb[1]))
+                {
                     Kind::Line(nb[0], nb[1])
                 } else {
                     Kind::Fixed
@@ -808,41 +830,14 @@ pub fn ball_valid(mesh: &TetMesh, ball: &[u32]) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::mesh::MeshData;
 
-    /// The 6 Kuhn tets of each unit cube of an n³ block.
+    /// The 6 Kuhn tets of each unit cube of an n³ block: the crate's
+    /// generator (on the unit cube, x fastest) scaled by n, so that point
+    /// (i, j, k) has id i + (n+1)(j + (n+1)k).
     fn kuhn(n: usize) -> TetMesh {
-        let id = |i: usize, j: usize, k: usize| (i + (n + 1) * (j + (n + 1) * k)) as u32;
-        let mut d = MeshData::default();
-        for k in 0..=n {
-            for j in 0..=n {
-                for i in 0..=n {
-                    d.points.push([i as f64, j as f64, k as f64]);
-                }
-            }
-        }
-        let perms = [
-            [0, 1, 2],
-            [0, 2, 1],
-            [1, 0, 2],
-            [1, 2, 0],
-            [2, 0, 1],
-            [2, 1, 0],
-        ];
-        for k in 0..n {
-            for j in 0..n {
-                for i in 0..n {
-                    for p in perms {
-                        let mut c = [i, j, k];
-                        let mut t = [id(i, j, k); 4];
-                        for (s, &axis) in p.iter().enumerate() {
-                            c[axis] += 1;
-                            t[s + 1] = id(c[0], c[1], c[2]);
-                        }
-                        d.tets.push(t);
-                    }
-                }
-            }
+        let mut d = crate::mesh::generate::cube_grid(n);
+        for p in &mut d.points {
+            *p = p.map(|x| (x * n as f64).round());
         }
         TetMesh::from_data(&d).unwrap().0
     }
