@@ -58,7 +58,7 @@ pub mod tetgen;
 pub mod topo;
 
 pub use file::IoError;
-pub use improve::{improve, Effort, ImproveOptions, ImproveReport};
+pub use improve::{improve, BoundarySmoothOptions, Effort, ImproveOptions, ImproveReport};
 pub use io::{load_mesh, read_mesh, write_mesh};
 pub use mesh::generate::cube_grid;
 pub use mesh::{

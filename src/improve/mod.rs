@@ -12,6 +12,7 @@ pub mod optimize;
 pub mod passes;
 pub mod ring;
 
+pub use boundary_smooth::BoundarySmoothOptions;
 pub use effort::Effort;
 pub use passes::{improve, ImproveOptions, ImproveReport};
 

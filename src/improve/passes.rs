@@ -55,7 +55,7 @@ pub struct ImproveOptions {
     /// scan over the tet slots.
     pub smooth_block: usize,
     /// Boundary and interface vertices smoothed inside their patch
-    /// ([`super::boundary_smooth`]); `None`: the boundary stays fixed.
+    /// ([`BoundarySmoothOptions`]); `None`: the boundary stays fixed.
     pub boundary: Option<BoundarySmoothOptions>,
 }
 
