@@ -385,3 +385,65 @@ fn json_configuration_reads_and_reports_errors_by_line() {
     let e = catmull_clark_weighted(&cube(), 1, &cfg, &Features::default()).unwrap_err();
     assert!(e.to_string().contains("0-7"), "{e}");
 }
+
+#[test]
+fn vertex_extrusion_moves_vertex_points_along_the_vertex_normal() {
+    // Eq. 3 with w_v = 0 and extrusion w at the cube corner (0,0,0): the
+    // plain point (F̄ + 2R̄)/3 = (1/3 + 1/3)/3 (1,1,1) = (2/9)(1,1,1), moved
+    // along the normalised sum of the three unit face normals,
+    // −(1,1,1)/√3, times the mean √area of those faces, 1.
+    let w = 0.3;
+    let out = catmull_clark_weighted(
+        &cube(),
+        1,
+        &cfg_with(Weights {
+            vertex_extrude: w,
+            ..Default::default()
+        }),
+        &Features::default(),
+    )
+    .unwrap();
+    let expect = DVec3::splat(2.0 / 9.0) - DVec3::ONE / 3f64.sqrt() * w;
+    assert!(out.points[0].distance(expect) < 1e-15, "{}", out.points[0]);
+}
+
+#[test]
+fn face_point_weights_follow_equation_four_from_the_second_iteration() {
+    // Iteration 1 plain, iteration 2 with face_vertex = a, face_face = b:
+    // every quad of the plain first step is (vertex, edge, face, edge)
+    // derived, so its face point is
+    // (P₀(1 + a) + P₂(1 + b) + (P₁ + P₃)(1 − (a + b)/2))/4,
+    // computed here from plain Catmull–Clark, an independent code path.
+    let (a, b) = (0.4, -0.2);
+    let mesh = cube();
+    let cfg = WeightedConfig {
+        iterations: vec![
+            Weights::default(),
+            Weights {
+                face_vertex: a,
+                face_face: b,
+                ..Default::default()
+            },
+        ],
+        ..Default::default()
+    };
+    let one = catmull_clark(&mesh, 1, &Features::default()).unwrap();
+    let two = catmull_clark_weighted(&mesh, 2, &cfg, &Features::default()).unwrap();
+    let base = one.points.len() + one.edge_list().len();
+    for (f, q) in one.faces.iter().enumerate() {
+        let p = |k: usize| one.points[q[k] as usize];
+        let expect =
+            (p(0) * (1.0 + a) + p(2) * (1.0 + b) + (p(1) + p(3)) * (1.0 - (a + b) / 2.0)) / 4.0;
+        assert!(two.points[base + f].distance(expect) < 1e-14, "face {f}");
+    }
+    // In the first iteration eq. 4 does not apply: the same weights there
+    // give plain Catmull–Clark.
+    let first = WeightedConfig {
+        iterations: vec![cfg.iterations[1]],
+        ..Default::default()
+    };
+    assert_eq!(
+        catmull_clark_weighted(&mesh, 1, &first, &Features::default()).unwrap(),
+        one
+    );
+}
