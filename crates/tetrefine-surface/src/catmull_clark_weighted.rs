@@ -55,11 +55,13 @@
 //! Positions are those of the element: face centroid, edge midpoint, vertex.
 //! Face groups pass to the faces a face is split into; vertex groups hold
 //! original vertices (which keep their ids). A vertex group with
-//! `lock_iterations` = L keeps its vertices in place for the first L
-//! iterations; a locked edge with `iterations` = L keeps its endpoints in
-//! place and its edge point at its midpoint for L iterations, and its two
-//! halves stay locked for the rest of those iterations, so the original edge
-//! stays exactly where it was.
+//! `lock_iterations` = L and `lock_start` = N keeps its vertices in place in
+//! iterations N .. N + L (N = 0: the first L); a locked edge with
+//! `iterations` = L and `start` = N keeps the endpoints of the chain it has
+//! been split into by iteration N in place and their edge points at the
+//! midpoints in iterations N .. N + L, so the chain stays exactly where it
+//! was when the lock began (the paper's figure 9 locks after the 8th
+//! iteration). Locks of one edge in several groups join into one range.
 
 use super::catmull_clark::{
     catmull_clark_faces, crease_vertex_point, in_point_order, split_creases,
@@ -186,6 +188,9 @@ pub struct VertexGroup {
     pub weights: Option<Weights>,
     /// The vertices stay in place for this many iterations.
     pub lock_iterations: usize,
+    /// The first locked iteration (from 0): the vertices are locked in
+    /// iterations `lock_start .. lock_start + lock_iterations`.
+    pub lock_start: usize,
 }
 
 /// A group of input faces with its own weights (passed to their children).
@@ -206,6 +211,10 @@ pub struct LockedEdges {
     pub edges: Vec<[u32; 2]>,
     /// Number of iterations during which they stay fixed.
     pub iterations: usize,
+    /// The first locked iteration (from 0): the lock holds in iterations
+    /// `start .. start + iterations`, on the chain of edges the input edge
+    /// has been split into by then.
+    pub start: usize,
 }
 
 /// Everything that controls the weighted scheme; read from JSON with
@@ -339,7 +348,8 @@ pub fn catmull_clark_weighted(
             }
         }
     }
-    let mut locked: HashMap<[u32; 2], usize> = HashMap::new();
+    // Locked edges with their range of iterations [start, end).
+    let mut locked: HashMap<[u32; 2], (usize, usize)> = HashMap::new();
     for grp in &cfg.locked_edges {
         for &[a, b] in &grp.edges {
             let e = sorted_pair(a, b);
@@ -347,8 +357,9 @@ pub fn catmull_clark_weighted(
                 return Err(SubdivisionError::NoSuchEdge(e));
             }
             if grp.iterations > 0 {
-                let l = locked.entry(e).or_insert(0);
-                *l = (*l).max(grp.iterations);
+                let end = grp.start.saturating_add(grp.iterations);
+                let l = locked.entry(e).or_insert((grp.start, end));
+                *l = (l.0.min(grp.start), l.1.max(end));
             }
         }
     }
@@ -390,10 +401,16 @@ pub fn catmull_clark_weighted(
         let (curve, roles) = classify(h, creases, &corners);
         let vertex_locked: Vec<bool> = (0..cur.points.len())
             .map(|v| {
-                vertex_group
-                    .get(&(v as u32))
-                    .is_some_and(|&g| it < cfg.vertex_groups[g].lock_iterations)
+                vertex_group.get(&(v as u32)).is_some_and(|&g| {
+                    let grp = &cfg.vertex_groups[g];
+                    grp.lock_start <= it && it < grp.lock_start.saturating_add(grp.lock_iterations)
+                })
             })
+            .collect();
+        let active_locks: HashMap<[u32; 2], usize> = locked
+            .iter()
+            .filter(|(_, &(start, end))| start <= it && it < end)
+            .map(|(&e, &(_, end))| (e, end))
             .collect();
         let ctx = StepContext {
             mesh: cur,
@@ -404,7 +421,7 @@ pub fn catmull_clark_weighted(
             face_group: &face_group,
             vertex_group: &vertex_group,
             vertex_locked: &vertex_locked,
-            locked: &locked,
+            locked: &active_locks,
             cfg,
             spatial: &spatial,
             base,
@@ -424,11 +441,11 @@ pub fn catmull_clark_weighted(
         }
         let mut next_locked = HashMap::new();
         for (e, pair) in h.edges.iter().enumerate() {
-            if let Some(&l) = locked.get(pair) {
-                if l > 1 {
+            if let Some(&(start, end)) = locked.get(pair) {
+                if it + 1 < end {
                     let m = (nv + e) as u32;
-                    next_locked.insert(sorted_pair(pair[0], m), l - 1);
-                    next_locked.insert(sorted_pair(m, pair[1]), l - 1);
+                    next_locked.insert(sorted_pair(pair[0], m), (start, end));
+                    next_locked.insert(sorted_pair(m, pair[1]), (start, end));
                 }
             }
         }

@@ -45,6 +45,7 @@ fn zero_weights_give_plain_catmull_clark_bit_for_bit() {
                 vertices: vec![1, 2],
                 weights: Some(zero),
                 lock_iterations: 0,
+                lock_start: 0,
             }],
             face_groups: vec![FaceGroup {
                 faces: vec![0],
@@ -260,6 +261,7 @@ fn locked_edges_stay_fixed_for_l_iterations() {
         locked_edges: vec![LockedEdges {
             edges: vec![[1, 0]],
             iterations: 2,
+            start: 0,
         }],
         ..Default::default()
     };
@@ -303,6 +305,7 @@ fn vertex_groups_lock_their_vertices() {
             vertices: vec![7],
             weights: None,
             lock_iterations: 2,
+            lock_start: 0,
         }],
         ..Default::default()
     };
@@ -379,6 +382,7 @@ fn json_configuration_reads_and_reports_errors_by_line() {
         locked_edges: vec![LockedEdges {
             edges: vec![[0, 7]],
             iterations: 1,
+            start: 0,
         }],
         ..Default::default()
     };
@@ -446,4 +450,69 @@ fn face_point_weights_follow_equation_four_from_the_second_iteration() {
         catmull_clark_weighted(&mesh, 1, &first, &Features::default()).unwrap(),
         one
     );
+}
+
+#[test]
+fn locks_can_start_after_iteration_n() {
+    // Vertex 7 locked in iterations 1..3 (lock_start 1, 2 iterations): it
+    // moves as in plain Catmull–Clark in the first iteration and then stays
+    // there for two iterations; the fourth moves it again.
+    let mesh = cube();
+    let f = Features::default();
+    let cfg = WeightedConfig {
+        vertex_groups: vec![VertexGroup {
+            vertices: vec![7],
+            weights: None,
+            lock_iterations: 2,
+            lock_start: 1,
+        }],
+        ..Default::default()
+    };
+    let after_one = catmull_clark(&mesh, 1, &f).unwrap().points[7];
+    assert_eq!(
+        catmull_clark_weighted(&mesh, 1, &cfg, &f).unwrap().points[7],
+        after_one
+    );
+    for k in 2..=3 {
+        let out = catmull_clark_weighted(&mesh, k, &cfg, &f).unwrap();
+        assert_eq!(out.points[7], after_one, "iteration {k}");
+    }
+    let four = catmull_clark_weighted(&mesh, 4, &cfg, &f).unwrap();
+    assert_ne!(four.points[7], after_one);
+
+    // Edge 0-1 locked from iteration 1 for 2 iterations: after the first
+    // (plain) iteration it is the chain v0, m, v1; those three points stay,
+    // and after iterations 2 and 3 the chain has 5 and 9 points on the
+    // straight segments v0-m and m-v1, at their dyadic fractions.
+    let cfg = WeightedConfig {
+        locked_edges: vec![LockedEdges {
+            edges: vec![[0, 1]],
+            iterations: 2,
+            start: 1,
+        }],
+        ..Default::default()
+    };
+    let one = catmull_clark(&mesh, 1, &f).unwrap();
+    let e01 = mesh.edge_list().iter().position(|e| *e == [0, 1]).unwrap();
+    let (a, m, b) = (one.points[0], one.points[8 + e01], one.points[1]);
+    assert_eq!(catmull_clark_weighted(&mesh, 1, &cfg, &f).unwrap(), one);
+    for k in 2..=3usize {
+        let out = catmull_clark_weighted(&mesh, k, &cfg, &f).unwrap();
+        assert_eq!(out.points[0], a);
+        assert_eq!(out.points[1], b);
+        assert_eq!(out.points[8 + e01], m);
+        let n = 1usize << (k - 1);
+        for (p, q) in [(a, m), (m, b)] {
+            for j in 0..=n {
+                let t = j as f64 / n as f64;
+                let x = p + (q - p) * t;
+                assert!(
+                    out.points.iter().any(|y| y.distance(x) < 1e-15),
+                    "iteration {k}: no chain point at {x}"
+                );
+            }
+        }
+    }
+    let four = catmull_clark_weighted(&mesh, 4, &cfg, &f).unwrap();
+    assert_ne!(four.points[0], a);
 }
