@@ -25,7 +25,10 @@
 //!    new face points around, R̄ the average of the midpoints of the edges.
 //! 4. Attraction/deflection (eqs. 10, 11): F ← F + w₆ Σ (Pₖ − F) μ(Pₖ)/n and
 //!    E ← E + w₇ ((P₁ − E) μ(P₁) + (P₂ − E) μ(P₂)), w₆ = `face_attract`,
-//!    w₇ = `edge_attract`, μ(P) the value of `mu_by_valence` for the valence
+//!    w₇ = `edge_attract`, μ(P) the value of `mu_by_pattern` for the
+//!    face/edge motif of P (the paper's figure 3: `"4F4E"` is a vertex in 4
+//!    faces with 4 edges; on an open boundary or after joins the two
+//!    differ), else of `mu_by_valence` for the valence
 //!    of P (0 if absent).
 //!
 //! Normals: n_f is the unit face normal, n_e the normalised average of the
@@ -226,6 +229,10 @@ pub struct WeightedConfig {
     pub iterations: Vec<Weights>,
     /// Attractor/deflector value μ by vertex valence (eqs. 10, 11).
     pub mu_by_valence: BTreeMap<u32, f64>,
+    /// Attractor/deflector value μ by face/edge motif, `"<faces>F<edges>E"`
+    /// (eqs. 10, 11; the paper's figure 3); it takes precedence over
+    /// `mu_by_valence`.
+    pub mu_by_pattern: BTreeMap<String, f64>,
     /// Weight sets placed in space.
     pub attractors: Option<Attractors>,
     /// A linear gradient along an axis.
@@ -395,6 +402,23 @@ pub fn catmull_clark_weighted(
         }
     }
     let spatial = Spatial { cfg, scale };
+    let mut mu_pattern: HashMap<(u32, u32), f64> = HashMap::new();
+    for (key, &mu) in &cfg.mu_by_pattern {
+        let parsed = key
+            .strip_suffix('E')
+            .and_then(|k| k.split_once('F'))
+            .and_then(|(f, e)| Some((f.parse::<u32>().ok()?, e.parse::<u32>().ok()?)));
+        match parsed {
+            Some(fe) => {
+                mu_pattern.insert(fe, mu);
+            }
+            None => {
+                return Err(SubdivisionError::BadParameter(format!(
+                    "mu_by_pattern key '{key}' is not a face/edge motif such as \"4F4E\""
+                )))
+            }
+        }
+    }
     let mut origin = vec![Origin::Input; mesh.points.len()];
     run_steps(mesh, he0, creases, steps, |it, cur, h, creases| {
         let base = cfg.iteration_weights(it);
@@ -424,6 +448,7 @@ pub fn catmull_clark_weighted(
             locked: &active_locks,
             cfg,
             spatial: &spatial,
+            mu_pattern: &mu_pattern,
             base,
             first: it == 0,
         };
@@ -468,6 +493,7 @@ struct StepContext<'a> {
     locked: &'a HashMap<[u32; 2], usize>,
     cfg: &'a WeightedConfig,
     spatial: &'a Spatial<'a>,
+    mu_pattern: &'a HashMap<(u32, u32), f64>,
     base: Weights,
     first: bool,
 }
@@ -480,7 +506,11 @@ impl StepContext<'_> {
         }
     }
 
-    fn mu(&self, valence: &[u32], v: u32) -> f64 {
+    fn mu(&self, valence: &[u32], faces_at: &[u32], v: u32) -> f64 {
+        let key = (faces_at[v as usize], valence[v as usize]);
+        if let Some(&m) = self.mu_pattern.get(&key) {
+            return m;
+        }
         self.cfg
             .mu_by_valence
             .get(&valence[v as usize])
@@ -493,6 +523,10 @@ impl StepContext<'_> {
         let he = self.he;
         let p = &mesh.points;
         let valence = he.valences();
+        let mut faces_at = vec![0u32; p.len()];
+        for &o in &he.origin {
+            faces_at[o as usize] += 1;
+        }
         // Unit normals and √area of the faces.
         let normals: Vec<(DVec3, f64)> = (0..mesh.faces.len())
             .into_par_iter()
@@ -539,7 +573,7 @@ impl StepContext<'_> {
                 let mut fpt = s / n as f64 + nrm * size * w.face_extrude;
                 let mut att = DVec3::ZERO;
                 for &v in face {
-                    att += (p[v as usize] - fpt) * self.mu(&valence, v);
+                    att += (p[v as usize] - fpt) * self.mu(&valence, &faces_at, v);
                 }
                 fpt += att / n as f64 * w.face_attract;
                 fpt
@@ -568,7 +602,8 @@ impl StepContext<'_> {
                 let size = (normals[f1].1 + normals[f2].1) * 0.5;
                 let mut ept = (ff * (1.0 + w.edge) + pp * (1.0 - w.edge)) * 0.25
                     + nrm * size * w.edge_extrude;
-                let att = (pa - ept) * self.mu(&valence, a) + (pb - ept) * self.mu(&valence, b);
+                let att = (pa - ept) * self.mu(&valence, &faces_at, a)
+                    + (pb - ept) * self.mu(&valence, &faces_at, b);
                 ept += att * w.edge_attract;
                 ept
             })

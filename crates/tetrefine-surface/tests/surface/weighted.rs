@@ -32,6 +32,7 @@ fn zero_weights_give_plain_catmull_clark_bit_for_bit() {
         WeightedConfig {
             iterations: vec![zero, zero],
             mu_by_valence: [(3, 1.0), (4, -0.5)].into_iter().collect(),
+            mu_by_pattern: [("3F3E".to_string(), 2.0)].into_iter().collect(),
             attractors: Some(Attractors {
                 tightness: 2.0,
                 sets: vec![AttractorSet {
@@ -515,4 +516,39 @@ fn locks_can_start_after_iteration_n() {
     }
     let four = catmull_clark_weighted(&mesh, 4, &cfg, &f).unwrap();
     assert_ne!(four.points[0], a);
+}
+
+#[test]
+fn mu_by_face_edge_pattern_overrides_mu_by_valence() {
+    // One open unit quad: its corners are in 1 face with 2 edges ("1F2E").
+    // Face point extruded by 0.5 along +z (√area = 1); eq. 10 with w₆ = 1
+    // and μ = 1 at every corner pulls it back to the centroid exactly as
+    // F + Σ(Pₖ − F)/4 = centroid; μ by pattern 0 overrides μ by valence 1.
+    let quad = PolyMesh::new(
+        vec![DVec3::ZERO, DVec3::X, DVec3::new(1.0, 1.0, 0.0), DVec3::Y],
+        vec![vec![0, 1, 2, 3]],
+    );
+    let w = Weights {
+        face_extrude: 0.5,
+        face_attract: 1.0,
+        ..Default::default()
+    };
+    let f = Features::default();
+    let run = |valence: &[(u32, f64)], pattern: &[(&str, f64)]| {
+        let cfg = WeightedConfig {
+            iterations: vec![w],
+            mu_by_valence: valence.iter().copied().collect(),
+            mu_by_pattern: pattern.iter().map(|(k, v)| (k.to_string(), *v)).collect(),
+            ..Default::default()
+        };
+        catmull_clark_weighted(&quad, 1, &cfg, &f).map(|m| m.points[8])
+    };
+    let centroid = DVec3::new(0.5, 0.5, 0.0);
+    let extruded = centroid + DVec3::Z * 0.5;
+    assert!(run(&[], &[("1F2E", 1.0)]).unwrap().distance(centroid) < 1e-15);
+    assert!(run(&[(2, 1.0)], &[]).unwrap().distance(centroid) < 1e-15);
+    assert_eq!(run(&[(2, 1.0)], &[("1F2E", 0.0)]).unwrap(), extruded);
+    assert_eq!(run(&[], &[("2F2E", 1.0)]).unwrap(), extruded);
+    let e = run(&[], &[("4F", 1.0)]).unwrap_err().to_string();
+    assert!(e.contains("'4F'"), "{e}");
 }
