@@ -25,7 +25,10 @@
 //!    new face points around, R̄ the average of the midpoints of the edges.
 //! 4. Attraction/deflection (eqs. 10, 11): F ← F + w₆ Σ (Pₖ − F) μ(Pₖ)/n and
 //!    E ← E + w₇ ((P₁ − E) μ(P₁) + (P₂ − E) μ(P₂)), w₆ = `face_attract`,
-//!    w₇ = `edge_attract`, μ(P) the value of `mu_by_valence` for the valence
+//!    w₇ = `edge_attract`, μ(P) the value of `mu_by_pattern` for the
+//!    face/edge motif of P (the paper's figure 3: `"4F4E"` is a vertex in 4
+//!    faces with 4 edges; on an open boundary or after joins the two
+//!    differ), else of `mu_by_valence` for the valence
 //!    of P (0 if absent).
 //!
 //! Normals: n_f is the unit face normal, n_e the normalised average of the
@@ -55,11 +58,13 @@
 //! Positions are those of the element: face centroid, edge midpoint, vertex.
 //! Face groups pass to the faces a face is split into; vertex groups hold
 //! original vertices (which keep their ids). A vertex group with
-//! `lock_iterations` = L keeps its vertices in place for the first L
-//! iterations; a locked edge with `iterations` = L keeps its endpoints in
-//! place and its edge point at its midpoint for L iterations, and its two
-//! halves stay locked for the rest of those iterations, so the original edge
-//! stays exactly where it was.
+//! `lock_iterations` = L and `lock_start` = N keeps its vertices in place in
+//! iterations N .. N + L (N = 0: the first L); a locked edge with
+//! `iterations` = L and `start` = N keeps the endpoints of the chain it has
+//! been split into by iteration N in place and their edge points at the
+//! midpoints in iterations N .. N + L, so the chain stays exactly where it
+//! was when the lock began (the paper's figure 9 locks after the 8th
+//! iteration). Locks of one edge in several groups join into one range.
 
 use super::catmull_clark::{
     catmull_clark_faces, crease_vertex_point, in_point_order, split_creases,
@@ -186,6 +191,9 @@ pub struct VertexGroup {
     pub weights: Option<Weights>,
     /// The vertices stay in place for this many iterations.
     pub lock_iterations: usize,
+    /// The first locked iteration (from 0): the vertices are locked in
+    /// iterations `lock_start .. lock_start + lock_iterations`.
+    pub lock_start: usize,
 }
 
 /// A group of input faces with its own weights (passed to their children).
@@ -206,6 +214,10 @@ pub struct LockedEdges {
     pub edges: Vec<[u32; 2]>,
     /// Number of iterations during which they stay fixed.
     pub iterations: usize,
+    /// The first locked iteration (from 0): the lock holds in iterations
+    /// `start .. start + iterations`, on the chain of edges the input edge
+    /// has been split into by then.
+    pub start: usize,
 }
 
 /// Everything that controls the weighted scheme; read from JSON with
@@ -217,6 +229,10 @@ pub struct WeightedConfig {
     pub iterations: Vec<Weights>,
     /// Attractor/deflector value μ by vertex valence (eqs. 10, 11).
     pub mu_by_valence: BTreeMap<u32, f64>,
+    /// Attractor/deflector value μ by face/edge motif, `"<faces>F<edges>E"`
+    /// (eqs. 10, 11; the paper's figure 3); it takes precedence over
+    /// `mu_by_valence`.
+    pub mu_by_pattern: BTreeMap<String, f64>,
     /// Weight sets placed in space.
     pub attractors: Option<Attractors>,
     /// A linear gradient along an axis.
@@ -339,7 +355,8 @@ pub fn catmull_clark_weighted(
             }
         }
     }
-    let mut locked: HashMap<[u32; 2], usize> = HashMap::new();
+    // Locked edges with their range of iterations [start, end).
+    let mut locked: HashMap<[u32; 2], (usize, usize)> = HashMap::new();
     for grp in &cfg.locked_edges {
         for &[a, b] in &grp.edges {
             let e = sorted_pair(a, b);
@@ -347,8 +364,9 @@ pub fn catmull_clark_weighted(
                 return Err(SubdivisionError::NoSuchEdge(e));
             }
             if grp.iterations > 0 {
-                let l = locked.entry(e).or_insert(0);
-                *l = (*l).max(grp.iterations);
+                let end = grp.start.saturating_add(grp.iterations);
+                let l = locked.entry(e).or_insert((grp.start, end));
+                *l = (l.0.min(grp.start), l.1.max(end));
             }
         }
     }
@@ -384,16 +402,39 @@ pub fn catmull_clark_weighted(
         }
     }
     let spatial = Spatial { cfg, scale };
+    let mut mu_pattern: HashMap<(u32, u32), f64> = HashMap::new();
+    for (key, &mu) in &cfg.mu_by_pattern {
+        let parsed = key
+            .strip_suffix('E')
+            .and_then(|k| k.split_once('F'))
+            .and_then(|(f, e)| Some((f.parse::<u32>().ok()?, e.parse::<u32>().ok()?)));
+        match parsed {
+            Some(fe) => {
+                mu_pattern.insert(fe, mu);
+            }
+            None => {
+                return Err(SubdivisionError::BadParameter(format!(
+                    "mu_by_pattern key '{key}' is not a face/edge motif such as \"4F4E\""
+                )))
+            }
+        }
+    }
     let mut origin = vec![Origin::Input; mesh.points.len()];
     run_steps(mesh, he0, creases, steps, |it, cur, h, creases| {
         let base = cfg.iteration_weights(it);
         let (curve, roles) = classify(h, creases, &corners);
         let vertex_locked: Vec<bool> = (0..cur.points.len())
             .map(|v| {
-                vertex_group
-                    .get(&(v as u32))
-                    .is_some_and(|&g| it < cfg.vertex_groups[g].lock_iterations)
+                vertex_group.get(&(v as u32)).is_some_and(|&g| {
+                    let grp = &cfg.vertex_groups[g];
+                    grp.lock_start <= it && it < grp.lock_start.saturating_add(grp.lock_iterations)
+                })
             })
+            .collect();
+        let active_locks: HashMap<[u32; 2], usize> = locked
+            .iter()
+            .filter(|(_, &(start, end))| start <= it && it < end)
+            .map(|(&e, &(_, end))| (e, end))
             .collect();
         let ctx = StepContext {
             mesh: cur,
@@ -404,9 +445,10 @@ pub fn catmull_clark_weighted(
             face_group: &face_group,
             vertex_group: &vertex_group,
             vertex_locked: &vertex_locked,
-            locked: &locked,
+            locked: &active_locks,
             cfg,
             spatial: &spatial,
+            mu_pattern: &mu_pattern,
             base,
             first: it == 0,
         };
@@ -424,11 +466,11 @@ pub fn catmull_clark_weighted(
         }
         let mut next_locked = HashMap::new();
         for (e, pair) in h.edges.iter().enumerate() {
-            if let Some(&l) = locked.get(pair) {
-                if l > 1 {
+            if let Some(&(start, end)) = locked.get(pair) {
+                if it + 1 < end {
                     let m = (nv + e) as u32;
-                    next_locked.insert(sorted_pair(pair[0], m), l - 1);
-                    next_locked.insert(sorted_pair(m, pair[1]), l - 1);
+                    next_locked.insert(sorted_pair(pair[0], m), (start, end));
+                    next_locked.insert(sorted_pair(m, pair[1]), (start, end));
                 }
             }
         }
@@ -451,6 +493,7 @@ struct StepContext<'a> {
     locked: &'a HashMap<[u32; 2], usize>,
     cfg: &'a WeightedConfig,
     spatial: &'a Spatial<'a>,
+    mu_pattern: &'a HashMap<(u32, u32), f64>,
     base: Weights,
     first: bool,
 }
@@ -463,7 +506,11 @@ impl StepContext<'_> {
         }
     }
 
-    fn mu(&self, valence: &[u32], v: u32) -> f64 {
+    fn mu(&self, valence: &[u32], faces_at: &[u32], v: u32) -> f64 {
+        let key = (faces_at[v as usize], valence[v as usize]);
+        if let Some(&m) = self.mu_pattern.get(&key) {
+            return m;
+        }
         self.cfg
             .mu_by_valence
             .get(&valence[v as usize])
@@ -476,6 +523,10 @@ impl StepContext<'_> {
         let he = self.he;
         let p = &mesh.points;
         let valence = he.valences();
+        let mut faces_at = vec![0u32; p.len()];
+        for &o in &he.origin {
+            faces_at[o as usize] += 1;
+        }
         // Unit normals and √area of the faces.
         let normals: Vec<(DVec3, f64)> = (0..mesh.faces.len())
             .into_par_iter()
@@ -522,7 +573,7 @@ impl StepContext<'_> {
                 let mut fpt = s / n as f64 + nrm * size * w.face_extrude;
                 let mut att = DVec3::ZERO;
                 for &v in face {
-                    att += (p[v as usize] - fpt) * self.mu(&valence, v);
+                    att += (p[v as usize] - fpt) * self.mu(&valence, &faces_at, v);
                 }
                 fpt += att / n as f64 * w.face_attract;
                 fpt
@@ -551,7 +602,8 @@ impl StepContext<'_> {
                 let size = (normals[f1].1 + normals[f2].1) * 0.5;
                 let mut ept = (ff * (1.0 + w.edge) + pp * (1.0 - w.edge)) * 0.25
                     + nrm * size * w.edge_extrude;
-                let att = (pa - ept) * self.mu(&valence, a) + (pb - ept) * self.mu(&valence, b);
+                let att = (pa - ept) * self.mu(&valence, &faces_at, a)
+                    + (pb - ept) * self.mu(&valence, &faces_at, b);
                 ept += att * w.edge_attract;
                 ept
             })

@@ -32,6 +32,7 @@ fn zero_weights_give_plain_catmull_clark_bit_for_bit() {
         WeightedConfig {
             iterations: vec![zero, zero],
             mu_by_valence: [(3, 1.0), (4, -0.5)].into_iter().collect(),
+            mu_by_pattern: [("3F3E".to_string(), 2.0)].into_iter().collect(),
             attractors: Some(Attractors {
                 tightness: 2.0,
                 sets: vec![AttractorSet {
@@ -45,6 +46,7 @@ fn zero_weights_give_plain_catmull_clark_bit_for_bit() {
                 vertices: vec![1, 2],
                 weights: Some(zero),
                 lock_iterations: 0,
+                lock_start: 0,
             }],
             face_groups: vec![FaceGroup {
                 faces: vec![0],
@@ -260,6 +262,7 @@ fn locked_edges_stay_fixed_for_l_iterations() {
         locked_edges: vec![LockedEdges {
             edges: vec![[1, 0]],
             iterations: 2,
+            start: 0,
         }],
         ..Default::default()
     };
@@ -303,6 +306,7 @@ fn vertex_groups_lock_their_vertices() {
             vertices: vec![7],
             weights: None,
             lock_iterations: 2,
+            lock_start: 0,
         }],
         ..Default::default()
     };
@@ -379,9 +383,172 @@ fn json_configuration_reads_and_reports_errors_by_line() {
         locked_edges: vec![LockedEdges {
             edges: vec![[0, 7]],
             iterations: 1,
+            start: 0,
         }],
         ..Default::default()
     };
     let e = catmull_clark_weighted(&cube(), 1, &cfg, &Features::default()).unwrap_err();
     assert!(e.to_string().contains("0-7"), "{e}");
+}
+
+#[test]
+fn vertex_extrusion_moves_vertex_points_along_the_vertex_normal() {
+    // Eq. 3 with w_v = 0 and extrusion w at the cube corner (0,0,0): the
+    // plain point (F̄ + 2R̄)/3 = (1/3 + 1/3)/3 (1,1,1) = (2/9)(1,1,1), moved
+    // along the normalised sum of the three unit face normals,
+    // −(1,1,1)/√3, times the mean √area of those faces, 1.
+    let w = 0.3;
+    let out = catmull_clark_weighted(
+        &cube(),
+        1,
+        &cfg_with(Weights {
+            vertex_extrude: w,
+            ..Default::default()
+        }),
+        &Features::default(),
+    )
+    .unwrap();
+    let expect = DVec3::splat(2.0 / 9.0) - DVec3::ONE / 3f64.sqrt() * w;
+    assert!(out.points[0].distance(expect) < 1e-15, "{}", out.points[0]);
+}
+
+#[test]
+fn face_point_weights_follow_equation_four_from_the_second_iteration() {
+    // Iteration 1 plain, iteration 2 with face_vertex = a, face_face = b:
+    // every quad of the plain first step is (vertex, edge, face, edge)
+    // derived, so its face point is
+    // (P₀(1 + a) + P₂(1 + b) + (P₁ + P₃)(1 − (a + b)/2))/4,
+    // computed here from plain Catmull–Clark, an independent code path.
+    let (a, b) = (0.4, -0.2);
+    let mesh = cube();
+    let cfg = WeightedConfig {
+        iterations: vec![
+            Weights::default(),
+            Weights {
+                face_vertex: a,
+                face_face: b,
+                ..Default::default()
+            },
+        ],
+        ..Default::default()
+    };
+    let one = catmull_clark(&mesh, 1, &Features::default()).unwrap();
+    let two = catmull_clark_weighted(&mesh, 2, &cfg, &Features::default()).unwrap();
+    let base = one.points.len() + one.edge_list().len();
+    for (f, q) in one.faces.iter().enumerate() {
+        let p = |k: usize| one.points[q[k] as usize];
+        let expect =
+            (p(0) * (1.0 + a) + p(2) * (1.0 + b) + (p(1) + p(3)) * (1.0 - (a + b) / 2.0)) / 4.0;
+        assert!(two.points[base + f].distance(expect) < 1e-14, "face {f}");
+    }
+    // In the first iteration eq. 4 does not apply: the same weights there
+    // give plain Catmull–Clark.
+    let first = WeightedConfig {
+        iterations: vec![cfg.iterations[1]],
+        ..Default::default()
+    };
+    assert_eq!(
+        catmull_clark_weighted(&mesh, 1, &first, &Features::default()).unwrap(),
+        one
+    );
+}
+
+#[test]
+fn locks_can_start_after_iteration_n() {
+    // Vertex 7 locked in iterations 1..3 (lock_start 1, 2 iterations): it
+    // moves as in plain Catmull–Clark in the first iteration and then stays
+    // there for two iterations; the fourth moves it again.
+    let mesh = cube();
+    let f = Features::default();
+    let cfg = WeightedConfig {
+        vertex_groups: vec![VertexGroup {
+            vertices: vec![7],
+            weights: None,
+            lock_iterations: 2,
+            lock_start: 1,
+        }],
+        ..Default::default()
+    };
+    let after_one = catmull_clark(&mesh, 1, &f).unwrap().points[7];
+    assert_eq!(
+        catmull_clark_weighted(&mesh, 1, &cfg, &f).unwrap().points[7],
+        after_one
+    );
+    for k in 2..=3 {
+        let out = catmull_clark_weighted(&mesh, k, &cfg, &f).unwrap();
+        assert_eq!(out.points[7], after_one, "iteration {k}");
+    }
+    let four = catmull_clark_weighted(&mesh, 4, &cfg, &f).unwrap();
+    assert_ne!(four.points[7], after_one);
+
+    // Edge 0-1 locked from iteration 1 for 2 iterations: after the first
+    // (plain) iteration it is the chain v0, m, v1; those three points stay,
+    // and after iterations 2 and 3 the chain has 5 and 9 points on the
+    // straight segments v0-m and m-v1, at their dyadic fractions.
+    let cfg = WeightedConfig {
+        locked_edges: vec![LockedEdges {
+            edges: vec![[0, 1]],
+            iterations: 2,
+            start: 1,
+        }],
+        ..Default::default()
+    };
+    let one = catmull_clark(&mesh, 1, &f).unwrap();
+    let e01 = mesh.edge_list().iter().position(|e| *e == [0, 1]).unwrap();
+    let (a, m, b) = (one.points[0], one.points[8 + e01], one.points[1]);
+    assert_eq!(catmull_clark_weighted(&mesh, 1, &cfg, &f).unwrap(), one);
+    for k in 2..=3usize {
+        let out = catmull_clark_weighted(&mesh, k, &cfg, &f).unwrap();
+        assert_eq!(out.points[0], a);
+        assert_eq!(out.points[1], b);
+        assert_eq!(out.points[8 + e01], m);
+        let n = 1usize << (k - 1);
+        for (p, q) in [(a, m), (m, b)] {
+            for j in 0..=n {
+                let t = j as f64 / n as f64;
+                let x = p + (q - p) * t;
+                assert!(
+                    out.points.iter().any(|y| y.distance(x) < 1e-15),
+                    "iteration {k}: no chain point at {x}"
+                );
+            }
+        }
+    }
+    let four = catmull_clark_weighted(&mesh, 4, &cfg, &f).unwrap();
+    assert_ne!(four.points[0], a);
+}
+
+#[test]
+fn mu_by_face_edge_pattern_overrides_mu_by_valence() {
+    // One open unit quad: its corners are in 1 face with 2 edges ("1F2E").
+    // Face point extruded by 0.5 along +z (√area = 1); eq. 10 with w₆ = 1
+    // and μ = 1 at every corner pulls it back to the centroid exactly as
+    // F + Σ(Pₖ − F)/4 = centroid; μ by pattern 0 overrides μ by valence 1.
+    let quad = PolyMesh::new(
+        vec![DVec3::ZERO, DVec3::X, DVec3::new(1.0, 1.0, 0.0), DVec3::Y],
+        vec![vec![0, 1, 2, 3]],
+    );
+    let w = Weights {
+        face_extrude: 0.5,
+        face_attract: 1.0,
+        ..Default::default()
+    };
+    let f = Features::default();
+    let run = |valence: &[(u32, f64)], pattern: &[(&str, f64)]| {
+        let cfg = WeightedConfig {
+            iterations: vec![w],
+            mu_by_valence: valence.iter().copied().collect(),
+            mu_by_pattern: pattern.iter().map(|(k, v)| (k.to_string(), *v)).collect(),
+            ..Default::default()
+        };
+        catmull_clark_weighted(&quad, 1, &cfg, &f).map(|m| m.points[8])
+    };
+    let centroid = DVec3::new(0.5, 0.5, 0.0);
+    let extruded = centroid + DVec3::Z * 0.5;
+    assert!(run(&[], &[("1F2E", 1.0)]).unwrap().distance(centroid) < 1e-15);
+    assert!(run(&[(2, 1.0)], &[]).unwrap().distance(centroid) < 1e-15);
+    assert_eq!(run(&[(2, 1.0)], &[("1F2E", 0.0)]).unwrap(), extruded);
+    assert_eq!(run(&[], &[("2F2E", 1.0)]).unwrap(), extruded);
+    let e = run(&[], &[("4F", 1.0)]).unwrap_err().to_string();
+    assert!(e.contains("'4F'"), "{e}");
 }
