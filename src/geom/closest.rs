@@ -71,6 +71,55 @@ pub fn distance_to_triangle(p: DVec3, a: DVec3, b: DVec3, c: DVec3) -> f64 {
     (closest_point_on_triangle(p, a, b, c).0 - p).length()
 }
 
+/// Whether every point of the triangles `from` lies within `limit` of the
+/// union of the triangles `to` (one direction of a Hausdorff bound: call it
+/// both ways for the Hausdorff distance; used by the boundary cap removal
+/// and the boundary edge flip, `crate::ops`). On a triangle `S`, the distance to one
+/// triangle `T` of `to` is convex, so its largest value on `S` is at a corner
+/// of `S`; the distance to the union is at most the distance to any one `T`.
+/// So `min over T of max over the corners of S` bounds the distance on `S`
+/// from above (exactly, up to the rounding of the distances). Where that
+/// bound is above `limit`, `S` is cut in four at its edge midpoints and
+/// each piece is judged again, down to [`MAX_DEPTH`] cuts: pieces near the
+/// seam between two `T` shrink until their bound is tight, so the answer
+/// errs only on the safe side (a refusal) and only within a piece of
+/// 2^-MAX_DEPTH of the face's size of the limit.
+pub(crate) fn surfaces_within(from: &[[DVec3; 3]], to: &[[DVec3; 3]], limit: f64) -> bool {
+    fn piece(s: [DVec3; 3], to: &[[DVec3; 3]], limit: f64, depth: u32) -> bool {
+        let bound = to
+            .iter()
+            .map(|t| {
+                s.iter()
+                    .map(|&x| distance_to_triangle(x, t[0], t[1], t[2]))
+                    .fold(0.0, f64::max)
+            })
+            .fold(f64::INFINITY, f64::min);
+        if bound <= limit {
+            return true;
+        }
+        // The corners themselves are farther than the limit: no cut helps.
+        let corner_far = s.iter().any(|&x| {
+            to.iter()
+                .map(|t| distance_to_triangle(x, t[0], t[1], t[2]))
+                .fold(f64::INFINITY, f64::min)
+                > limit
+        });
+        if corner_far || depth == MAX_DEPTH {
+            return false;
+        }
+        let [a, b, c] = s;
+        let (ab, bc, ca) = ((a + b) * 0.5, (b + c) * 0.5, (c + a) * 0.5);
+        [[a, ab, ca], [ab, b, bc], [ca, bc, c], [ab, bc, ca]]
+            .into_iter()
+            .all(|q| piece(q, to, limit, depth + 1))
+    }
+    from.iter().all(|&f| piece(f, to, limit, 0))
+}
+
+/// Deepest cut of [`surfaces_within`]: 4^8 pieces at most per face, about 2^8 along
+/// a seam in practice.
+const MAX_DEPTH: u32 = 8;
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -104,5 +153,43 @@ mod tests {
             DVec3::new(3.0, 0.0, 9.0),
         );
         assert!((d - 5.0).abs() < 1e-15);
+    }
+
+    #[test]
+    fn the_distance_test_is_tight_between_parallel_squares_and_a_fold() {
+        let sq = |z: f64| {
+            let p = [
+                DVec3::new(0.0, 0.0, z),
+                DVec3::new(1.0, 0.0, z),
+                DVec3::new(1.0, 1.0, z),
+                DVec3::new(0.0, 1.0, z),
+            ];
+            [[p[0], p[1], p[2]], [p[0], p[2], p[3]]]
+        };
+        assert!(surfaces_within(&sq(0.25), &sq(0.0), 0.25 + 1e-15));
+        assert!(!surfaces_within(&sq(0.25), &sq(0.0), 0.25 - 1e-12));
+        // A flat square at z = h against the square folded along its
+        // diagonal (1,0)-(0,1): corners (0,0) and (1,1) at z = 0, the other
+        // two at z = 2h, i.e. the planes z = 2h(x + y) and z = 2h(2 - x - y).
+        // Every point of the flat square is h / sqrt(1 + 8h²) = 0.0962 (for
+        // h = 0.1) from the nearer plane, with its foot inside the fold's
+        // triangle, so 0.9 h fails and 1.1 h passes, both ways.
+        let h = 0.1;
+        let p = [
+            DVec3::new(0.0, 0.0, h),
+            DVec3::new(1.0, 0.0, h),
+            DVec3::new(1.0, 1.0, h),
+            DVec3::new(0.0, 1.0, h),
+        ];
+        let flat = [[p[0], p[1], p[2]], [p[0], p[2], p[3]]];
+        let q = [
+            DVec3::new(0.0, 0.0, 0.0),
+            DVec3::new(1.0, 0.0, 2.0 * h),
+            DVec3::new(1.0, 1.0, 0.0),
+            DVec3::new(0.0, 1.0, 2.0 * h),
+        ];
+        let fold = [[q[0], q[1], q[3]], [q[1], q[2], q[3]]];
+        assert!(!surfaces_within(&flat, &fold, 0.9 * h));
+        assert!(surfaces_within(&flat, &fold, 1.1 * h) && surfaces_within(&fold, &flat, 1.1 * h));
     }
 }

@@ -7,6 +7,7 @@
 //! flat tet returns [`OpError::WouldInvert`] and leaves the mesh untouched.
 //! The shared re-linking lives here in [`replace_cavity`].
 
+pub(crate) mod boundary_flip;
 pub(crate) mod bulk_flip;
 pub(crate) mod bulk_split;
 pub(crate) mod cap_removal;
@@ -23,6 +24,7 @@ pub(crate) mod trisect;
 use crate::mesh::{face_key, FaceKey, TetMesh, NO_ADJ};
 use crate::topo::TET_FACES;
 
+pub use boundary_flip::{boundary_flip_ring, flip_boundary_edge, BoundaryFlipLimits, TetsAtVertex};
 pub use bulk_flip::{flip23_bulk, FlipBatch};
 pub use bulk_split::split14_bulk;
 pub use cap_removal::{is_cap_below, remove_boundary_cap, CapLimits};
