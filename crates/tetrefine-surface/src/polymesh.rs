@@ -276,10 +276,7 @@ impl HalfEdges {
 
     fn check_vertex_fans(&self) -> Result<(), TopologyError> {
         let np = self.vertex_out.len();
-        let mut degree = vec![0u32; np];
-        for &v in &self.origin {
-            degree[v as usize] += 1;
-        }
+        let degree = self.faces_at();
         let bad = (0..np).into_par_iter().find_map_first(|v| {
             let start = self.vertex_out[v];
             if start == NO_TWIN {
@@ -433,6 +430,16 @@ impl HalfEdges {
             }
         }
         (ring, boundary)
+    }
+
+    /// Number of faces at each vertex (0 for unused points): the half-edges
+    /// leaving it, one per face corner.
+    pub fn faces_at(&self) -> Vec<u32> {
+        let mut n = vec![0u32; self.vertex_out.len()];
+        for &v in &self.origin {
+            n[v as usize] += 1;
+        }
+        n
     }
 
     /// Number of edges at each vertex (0 for unused points).
