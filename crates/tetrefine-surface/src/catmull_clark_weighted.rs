@@ -431,10 +431,10 @@ pub fn catmull_clark_weighted(
                 })
             })
             .collect();
-        let active_locks: HashMap<[u32; 2], usize> = locked
+        let active_locks: HashSet<[u32; 2]> = locked
             .iter()
             .filter(|(_, &(start, end))| start <= it && it < end)
-            .map(|(&e, &(_, end))| (e, end))
+            .map(|(&e, _)| e)
             .collect();
         let ctx = StepContext {
             mesh: cur,
@@ -490,7 +490,7 @@ struct StepContext<'a> {
     face_group: &'a [Option<usize>],
     vertex_group: &'a HashMap<u32, usize>,
     vertex_locked: &'a [bool],
-    locked: &'a HashMap<[u32; 2], usize>,
+    locked: &'a HashSet<[u32; 2]>,
     cfg: &'a WeightedConfig,
     spatial: &'a Spatial<'a>,
     mu_pattern: &'a HashMap<(u32, u32), f64>,
@@ -523,10 +523,7 @@ impl StepContext<'_> {
         let he = self.he;
         let p = &mesh.points;
         let valence = he.valences();
-        let mut faces_at = vec![0u32; p.len()];
-        for &o in &he.origin {
-            faces_at[o as usize] += 1;
-        }
+        let faces_at = he.faces_at();
         // Unit normals and √area of the faces.
         let normals: Vec<(DVec3, f64)> = (0..mesh.faces.len())
             .into_par_iter()
@@ -586,7 +583,7 @@ impl StepContext<'_> {
                 let [a, b] = he.edges[e];
                 let (pa, pb) = (p[a as usize], p[b as usize]);
                 let pp = pa + pb;
-                if self.curve[e] || self.locked.contains_key(&he.edges[e]) {
+                if self.curve[e] || self.locked.contains(&he.edges[e]) {
                     return pp * 0.5;
                 }
                 let h = he.edge_half[e];
@@ -610,7 +607,7 @@ impl StepContext<'_> {
             .collect();
         // Vertices at the end of a locked edge stay.
         let mut on_locked = vec![false; p.len()];
-        for pair in self.locked.keys() {
+        for pair in self.locked {
             on_locked[pair[0] as usize] = true;
             on_locked[pair[1] as usize] = true;
         }
