@@ -6,6 +6,13 @@ use super::passes::ImproveOptions;
 use std::fmt;
 use std::str::FromStr;
 
+/// An edge longer than this times the mean edge length at its ends is split
+/// after a refinement step. Measured on the shipped meshes (one step, then
+/// the optimize phase): 1.4 raises the average minimum dihedral angle by
+/// 1.8°–3.3° for 20 %–60 % more tets and cuts the 99th-percentile edge by
+/// 15 %–35 %; 1.6 gains about half of that.
+pub const LONG_EDGE_FACTOR: f64 = 1.4;
+
 /// How hard mesh improvement works.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Effort {
@@ -60,6 +67,16 @@ impl Effort {
                 }),
                 ..base
             },
+        }
+    }
+
+    /// The long-edge factor of a refinement step at this effort
+    /// ([`ImproveOptions::long_edge_factor`]): `None` for `fast`, whose tet
+    /// count is the √3 step's own.
+    pub fn long_edge_factor(self) -> Option<f64> {
+        match self {
+            Effort::Fast => None,
+            Effort::Default | Effort::Best => Some(LONG_EDGE_FACTOR),
         }
     }
 

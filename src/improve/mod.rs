@@ -8,6 +8,7 @@ pub mod boundary_smooth;
 pub mod colour;
 pub mod effort;
 pub mod laplacian;
+mod long_edges;
 pub mod optimize;
 pub mod passes;
 pub mod ring;

@@ -12,6 +12,7 @@
 use super::boundary_smooth::{BoundarySmoothOptions, BoundarySmoothReport, BoundarySmoother};
 use super::colour::{colour_balls_except, sequential_levels, Balls};
 use super::laplacian::{laplacian_position_in, BallNow};
+use super::long_edges::split_long_edges;
 use super::optimize::{optimize_position_in, OptimizeParams};
 use super::ring::canonicalize_ring;
 use super::BallPoints;
@@ -57,6 +58,14 @@ pub struct ImproveOptions {
     /// Boundary and interface vertices smoothed inside their patch
     /// ([`BoundarySmoothOptions`]); `None`: the boundary stays fixed.
     pub boundary: Option<BoundarySmoothOptions>,
+    /// Before the passes, split at its midpoint every edge longer than this
+    /// factor times the mean edge length at its ends (a refinement step's
+    /// old edges, which the √3 operations keep); `None`: no split, the tet
+    /// count stays. Refinement sets it ([`Effort::long_edge_factor`](super::Effort::long_edge_factor)).
+    pub long_edge_factor: Option<f64>,
+    /// Per tet slot: may an edge of it be split by the long-edge pass? An
+    /// edge is split only if all its tets may be. `None`: as `tet_allowed`.
+    pub long_edge_zone: Option<Vec<bool>>,
 }
 
 impl Default for ImproveOptions {
@@ -71,6 +80,8 @@ impl Default for ImproveOptions {
             tet_allowed: None,
             smooth_block: 1 << 20,
             boundary: Some(BoundarySmoothOptions::default()),
+            long_edge_factor: None,
+            long_edge_zone: None,
         }
     }
 }
@@ -92,6 +103,22 @@ pub struct ImproveReport {
     pub line_moves: usize,
     /// Boundary sliver caps removed ([`crate::ops::remove_boundary_cap`]).
     pub caps_removed: usize,
+    /// Long edges split at their midpoint ([`ImproveOptions::long_edge_factor`]).
+    pub long_edges_split: usize,
+}
+
+impl ImproveReport {
+    /// Adds the counts of `other` (a later call on the same mesh).
+    pub fn add(&mut self, other: &ImproveReport) {
+        self.passes += other.passes;
+        self.edges_removed += other.edges_removed;
+        self.laplacian_moves += other.laplacian_moves;
+        self.optimized_moves += other.optimized_moves;
+        self.surface_moves += other.surface_moves;
+        self.line_moves += other.line_moves;
+        self.caps_removed += other.caps_removed;
+        self.long_edges_split += other.long_edges_split;
+    }
 }
 
 /// Work-tracking state of [`improve`]: per-slot quality and dirty flags, so
@@ -167,6 +194,21 @@ impl Tracker {
 /// parallel (in colour classes). The result does not depend on the
 /// number of threads.
 pub fn improve(mesh: &mut TetMesh, opts: &ImproveOptions) -> ImproveReport {
+    let mut report = ImproveReport::default();
+    let mut tet_allowed = opts.tet_allowed.clone();
+    // Points from long-edge splits lie in the zone, so they may move.
+    let first_new_point = mesh.n_points();
+    if let Some(factor) = opts.long_edge_factor {
+        let mut zone = opts.long_edge_zone.clone().or_else(|| tet_allowed.clone());
+        let (splits, new_tets) = split_long_edges(mesh, factor, opts.threshold, zone.as_mut());
+        report.long_edges_split = splits;
+        if let Some(a) = &mut tet_allowed {
+            a.resize(mesh.n_tet_slots().max(a.len()), false);
+            for t in new_tets {
+                a[t as usize] = true;
+            }
+        }
+    }
     let fixed = mesh.fixed_vertices();
     let movable: Vec<bool> = (0..mesh.n_points())
         .map(|v| {
@@ -174,12 +216,11 @@ pub fn improve(mesh: &mut TetMesh, opts: &ImproveOptions) -> ImproveReport {
                 && opts
                     .movable
                     .as_ref()
-                    .is_none_or(|m| m.get(v).copied().unwrap_or(false))
+                    .is_none_or(|m| m.get(v).copied().unwrap_or(v >= first_new_point))
         })
         .collect();
     drop(fixed);
-    let mut report = ImproveReport::default();
-    let mut tr = Tracker::new(mesh, opts.tet_allowed.clone());
+    let mut tr = Tracker::new(mesh, tet_allowed);
     let mut edges = EdgeRemoval::default();
     // Caps go before the smoother takes the boundary as its reference, and
     // again after the passes for those the passes left.

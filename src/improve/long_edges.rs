@@ -1,0 +1,251 @@
+//! Long-edge splits: the √3 operations never remove an old interior edge, so
+//! after a step the edges of the input stand out among the new ones (on the
+//! tripod the longest edge is 3.6 times the mean). An edge much longer than
+//! the edges around it is split at its midpoint by the shell split of
+//! [`split_edge`], the way MMG3D's size-driven remeshing and Rivara's
+//! longest-edge bisection split edges; the smoothing and edge removal that
+//! follow then even out the new vertex's ball.
+//!
+//! "Much longer" is relative: an edge `(a, b)` of length `l` is long when
+//! `l > factor · (L(a) + L(b)) / 2`, where `L(v)` is the mean length of the
+//! edges at `v` as the mesh stands before the pass. A graded mesh keeps its
+//! grading (an edge is compared with its neighbours, not with a global
+//! size), and a uniform mesh has no long edge.
+//!
+//! Only free interior edges are split: no feature edge and no edge of a
+//! constrained face (boundary, region interface, marked face). The domain,
+//! its regions, their boundary triangulations and the feature lines stay as
+//! the √3 step left them, so the next step's boundary rules and crease
+//! trisection see exactly the structure they expect.
+
+use crate::geom::tet_min_sine;
+use crate::mesh::TetMesh;
+use crate::ops::split_edge;
+use rayon::prelude::*;
+
+/// Per vertex, the sorted distinct neighbours of `v` (through its ball).
+fn neighbours(mesh: &TetMesh, v: u32, ball: &mut Vec<u32>, out: &mut Vec<u32>) {
+    mesh.ball(v, ball);
+    out.clear();
+    for &t in ball.iter() {
+        out.extend(mesh.tet(t).into_iter().filter(|&x| x != v));
+    }
+    out.sort_unstable();
+    out.dedup();
+}
+
+/// The tets holding edge `(a, b)`, from the ball of `a`.
+fn shell(mesh: &TetMesh, a: u32, b: u32, out: &mut Vec<u32>) {
+    mesh.ball(a, out);
+    out.retain(|&t| mesh.tet(t).contains(&b));
+}
+
+/// Whether no face of the shell holding `(a, b)` is constrained
+/// ([`TetMesh::face_is_constrained`]) and the edge is not a feature.
+fn is_free_edge(mesh: &TetMesh, a: u32, b: u32, sh: &[u32]) -> bool {
+    !mesh.is_feature_edge(a, b)
+        && sh.iter().all(|&t| {
+            let v = mesh.tet(t);
+            let adj = mesh.adj(t);
+            (0..4).all(|f| {
+                v[f] == a
+                    || v[f] == b
+                    || (adj[f] != crate::mesh::NO_ADJ && !mesh.is_interface_face(t, f))
+            })
+        })
+}
+
+/// Worst quality (min sine) of the shell of `(a, b)` as it stands, and of the
+/// two halves of every shell tet with `p` in place of `b` and of `a`.
+fn shell_qualities(mesh: &TetMesh, a: u32, b: u32, p: glam::DVec3, sh: &[u32]) -> (f64, f64) {
+    let mut old = f64::INFINITY;
+    let mut new = f64::INFINITY;
+    for &t in sh {
+        let v = mesh.tet(t);
+        let pts = mesh.tet_points(t);
+        old = old.min(tet_min_sine(&pts));
+        for replaced in [b, a] {
+            let mut q = pts;
+            let i = v
+                .iter()
+                .position(|&x| x == replaced)
+                .expect("a shell tet holds both ends of its edge");
+            q[i] = p;
+            new = new.min(tet_min_sine(&q));
+        }
+    }
+    (old, new)
+}
+
+/// Splits every free interior edge (see the module doc) longer than `factor` times the mean edge length at its
+/// two ends (see the module doc), longest first, at its midpoint. An edge
+/// is split only when every tet of its shell is in `zone` (per tet slot;
+/// `None`: every tet; the new tets join it) and when the worst of the new tets is at least the
+/// smaller of the shell's worst and `bar` (min sine), so the pass never
+/// lowers the worst tet below `bar`. Returns the number of edges split and
+/// the new tets.
+///
+/// The candidates are found in parallel and split in one fixed order
+/// (length, then vertex ids), so the result does not depend on the number
+/// of threads.
+pub(crate) fn split_long_edges(
+    mesh: &mut TetMesh,
+    factor: f64,
+    bar: f64,
+    mut zone: Option<&mut Vec<bool>>,
+) -> (usize, Vec<u32>) {
+    fn in_zone(zone: &Option<&mut Vec<bool>>, t: u32) -> bool {
+        zone.as_ref()
+            .is_none_or(|z| z.get(t as usize).copied().unwrap_or(false))
+    }
+    let n = mesh.n_points() as u32;
+    let mean_len: Vec<f64> = {
+        let mesh = &*mesh;
+        (0..n)
+            .into_par_iter()
+            .with_min_len(1024)
+            .map_init(
+                || (Vec::new(), Vec::new()),
+                |(ball, nb), v| {
+                    neighbours(mesh, v, ball, nb);
+                    if nb.is_empty() {
+                        return 0.0;
+                    }
+                    let p = mesh.point(v);
+                    nb.iter().map(|&u| p.distance(mesh.point(u))).sum::<f64>() / nb.len() as f64
+                },
+            )
+            .collect()
+    };
+    let mut long: Vec<(f64, u32, u32)> = {
+        let mesh = &*mesh;
+        let mean_len = &mean_len;
+        let zone = &zone;
+        (0..n)
+            .into_par_iter()
+            .with_min_len(1024)
+            .map_init(
+                || (Vec::new(), Vec::new(), Vec::new()),
+                |(ball, nb, sh), a| {
+                    neighbours(mesh, a, ball, nb);
+                    let pa = mesh.point(a);
+                    let mut found = Vec::new();
+                    for &b in nb.iter().filter(|&&b| b > a) {
+                        let l = pa.distance(mesh.point(b));
+                        let local = 0.5 * (mean_len[a as usize] + mean_len[b as usize]);
+                        if l > factor * local {
+                            shell(mesh, a, b, sh);
+                            if sh.iter().all(|&t| in_zone(zone, t)) && is_free_edge(mesh, a, b, sh)
+                            {
+                                found.push((l, a, b));
+                            }
+                        }
+                    }
+                    found
+                },
+            )
+            .flatten_iter()
+            .collect()
+    };
+    long.sort_unstable_by(|x, y| y.0.total_cmp(&x.0).then((x.1, x.2).cmp(&(y.1, y.2))));
+    let mut new_tets = Vec::new();
+    let mut splits = 0;
+    let mut sh = Vec::new();
+    for (_, a, b) in long {
+        // An earlier split may have taken the edge (a shared shell tet is
+        // gone, so the edge is no longer there): gather it again.
+        shell(mesh, a, b, &mut sh);
+        if sh.is_empty() || !sh.iter().all(|&t| in_zone(&zone, t)) {
+            continue;
+        }
+        let p = 0.5 * (mesh.point(a) + mesh.point(b));
+        let (old, new) = shell_qualities(mesh, a, b, p, &sh);
+        if new < old.min(bar) {
+            continue;
+        }
+        if let Ok((_, tets)) = split_edge(mesh, a, b, p) {
+            if let Some(z) = zone.as_deref_mut() {
+                z.resize(mesh.n_tet_slots().max(z.len()), false);
+                for &t in &tets {
+                    z[t as usize] = true;
+                }
+            }
+            new_tets.extend(tets);
+            splits += 1;
+        }
+    }
+    (splits, new_tets)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::MeshData;
+
+    /// A bipyramid: the axis `a = (0,0,-3)`, `b = (0,0,3)` (length 6) and a
+    /// ring of six points on the unit circle, six tets around the axis. By
+    /// hand: the mean edge length is (6 + 6·√10)/7 ≈ 3.567 at `a` and `b`
+    /// and (2·√10 + 2)/4 ≈ 2.081 at a ring point, so with factor 1.4 only
+    /// the axis is long (6 > 4.99; a spoke √10 ≈ 3.16 < 1.4·2.82; a ring
+    /// edge 1 < 1.4·2.08).
+    fn bipyramid() -> TetMesh {
+        let mut points = vec![[0.0, 0.0, -3.0], [0.0, 0.0, 3.0]];
+        for i in 0..6 {
+            let t = std::f64::consts::PI / 3.0 * i as f64;
+            points.push([t.cos(), t.sin(), 0.0]);
+        }
+        let tets = (0..6u32).map(|i| [0, 1, 2 + i, 2 + (i + 1) % 6]).collect();
+        let data = MeshData {
+            points,
+            tets,
+            ..Default::default()
+        };
+        TetMesh::from_data(&data).expect("a valid bipyramid").0
+    }
+
+    fn volume(m: &TetMesh) -> f64 {
+        m.tet_ids()
+            .map(|t| crate::geom::tet_volume(&m.tet_points(t)))
+            .sum()
+    }
+
+    #[test]
+    fn the_one_long_edge_is_split_at_its_midpoint() {
+        let mut m = bipyramid();
+        // Six triangles of area √3/4 times the height 6, over three.
+        let exact = 6.0 * 3f64.sqrt() / 4.0 * 6.0 / 3.0;
+        assert!((volume(&m) - exact).abs() < 1e-12);
+        let (splits, new) = split_long_edges(&mut m, 1.4, 0.3, None);
+        assert_eq!(splits, 1);
+        // Every tet of the six-tet shell becomes two.
+        assert_eq!(new.len(), 12);
+        assert_eq!(m.n_tets(), 12);
+        assert_eq!(m.n_points(), 9);
+        assert_eq!(m.point(8), glam::DVec3::ZERO);
+        assert!((volume(&m) - exact).abs() < 1e-12);
+        m.check().expect("a valid mesh after the split");
+        // Nothing is long any more at 1.4 (axis halves 3 against spokes √10).
+        assert_eq!(split_long_edges(&mut m, 1.4, 0.3, None).0, 0);
+    }
+
+    #[test]
+    fn an_edge_with_a_tet_outside_the_zone_stays() {
+        let mut m = bipyramid();
+        let mut zone = vec![true; m.n_tet_slots()];
+        zone[3] = false;
+        assert_eq!(split_long_edges(&mut m, 1.4, 0.3, Some(&mut zone)).0, 0);
+        assert_eq!(m.n_tets(), 6);
+        let mut zone = vec![true; m.n_tet_slots()];
+        let (splits, new) = split_long_edges(&mut m, 1.4, 0.3, Some(&mut zone));
+        assert_eq!(splits, 1);
+        assert!(new.iter().all(|&t| zone[t as usize]));
+    }
+
+    #[test]
+    fn a_higher_factor_splits_nothing() {
+        // The axis is 6 / 3.567 = 1.68 times its local mean.
+        let mut m = bipyramid();
+        assert_eq!(split_long_edges(&mut m, 1.7, 0.3, None).0, 0);
+        assert_eq!(split_long_edges(&mut m, 1.66, 0.3, None).0, 1);
+    }
+}
