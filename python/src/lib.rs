@@ -877,7 +877,8 @@ impl Mesh {
     /// patches and sliver-cap removal; features detected at feature_angle as
     /// `--features auto` does) — `tetrefine improve`. Returns a new Mesh whose
     /// `reports` hold one dict (passes, edges_removed, laplacian_moves,
-    /// optimized_moves, surface_moves, line_moves, caps_removed).
+    /// optimized_moves, surface_moves, line_moves, caps_removed,
+    /// long_edges_split; improve alone never splits).
     ///
     ///   opt_passes     Maximum passes of edge removal + smoothing
     ///                  [--opt-passes] (default 5).

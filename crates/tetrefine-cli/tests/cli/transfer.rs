@@ -74,6 +74,25 @@ struct Vtu {
     cell: Vec<(String, usize, Vec<f64>)>,
 }
 
+/// One linear-rule step of the tripod into `out`, carrying the fields of
+/// [`fields`].
+fn refine_tripod_with_fields(out: &Path) {
+    let inputs = tempfile::tempdir().unwrap();
+    let (fp, cp) = fields(inputs.path());
+    ok(&[
+        "refine",
+        "meshes/tripod.mesh",
+        "-o",
+        out.to_str().unwrap(),
+        "--boundary",
+        "linear",
+        "--fields",
+        &fp,
+        "--fields",
+        &cp,
+    ]);
+}
+
 fn read_vtu(path: &Path) -> Vtu {
     use vtkio::model::{Attribute, DataSet, Piece};
     let vtk = vtkio::Vtk::import(path).expect("vtkio reads the .vtu");
@@ -191,22 +210,9 @@ fn sol_fields_through_two_steps_in_the_vtu_and_the_parent_map() {
 
 #[test]
 fn fields_come_back_from_a_vtu_input_and_in_gmsh_and_medit_outputs() {
-    let inputs = tempfile::tempdir().unwrap();
-    let (fp, cp) = fields(inputs.path());
     let dir = tempfile::tempdir().unwrap();
     let step1 = dir.path().join("step1.vtu");
-    ok(&[
-        "refine",
-        "meshes/tripod.mesh",
-        "-o",
-        step1.to_str().unwrap(),
-        "--boundary",
-        "linear",
-        "--fields",
-        &fp,
-        "--fields",
-        &cp,
-    ]);
+    refine_tripod_with_fields(&step1);
     // Its point and cell data are the second step's fields (the derived
     // arrays — quality, parent, the parent map — are not).
     for out in ["step2.msh", "step2.mesh"] {
@@ -334,22 +340,9 @@ fn meshio_reads_the_transferred_fields() {
         eprintln!("skipped: python3 with meshio is not installed (pip install meshio)");
         return;
     }
-    let inputs = tempfile::tempdir().unwrap();
-    let (fp, cp) = fields(inputs.path());
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("o.vtu");
-    ok(&[
-        "refine",
-        "meshes/tripod.mesh",
-        "-o",
-        out.to_str().unwrap(),
-        "--boundary",
-        "linear",
-        "--fields",
-        &fp,
-        "--fields",
-        &cp,
-    ]);
+    refine_tripod_with_fields(&out);
     let script = r#"
 import sys, meshio, numpy as np
 m = meshio.read(sys.argv[1])
@@ -372,6 +365,8 @@ print(dev)
     // Gmsh: $NodeData as meshio reads it. (Its `$ElementData`, which covers
     // every element as meshio needs: python/tests/test_meshio.py, which CI
     // runs with meshio installed.)
+    let inputs = tempfile::tempdir().unwrap();
+    let (fp, _) = fields(inputs.path());
     let msh = dir.path().join("o.msh");
     ok(&[
         "refine",
