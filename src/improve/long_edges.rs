@@ -16,7 +16,12 @@
 //! constrained face (boundary, region interface, marked face). The domain,
 //! its regions, their boundary triangulations and the feature lines stay as
 //! the √3 step left them, so the next step's boundary rules and crease
-//! trisection see exactly the structure they expect.
+//! trisection see exactly the structure they expect. Nor is an edge between
+//! two fixed vertices (boundary, interface, feature) split: such a chord
+//! crosses a thin part of the domain, its midpoint sits close to the
+//! boundary, and the next step's splits made a sliver on a boundary face
+//! there that smoothing could not lift (tripod, a selection along its
+//! feature lines, two steps: 4.5° with chords split, 11.7° without).
 
 use crate::geom::tet_min_sine;
 use crate::mesh::TetMesh;
@@ -77,7 +82,7 @@ fn shell_qualities(mesh: &TetMesh, a: u32, b: u32, p: glam::DVec3, sh: &[u32]) -
     (old, new)
 }
 
-/// Splits every free interior edge (see the module doc) longer than `factor` times the mean edge length at its
+/// Splits every free interior edge that is not a chord (see the module doc) longer than `factor` times the mean edge length at its
 /// two ends (see the module doc), longest first, at its midpoint. An edge
 /// is split only when every tet of its shell is in `zone` (per tet slot;
 /// `None`: every tet; the new tets join it) and when the worst of the new tets is at least the
@@ -99,6 +104,7 @@ pub(crate) fn split_long_edges(
             .is_none_or(|z| z.get(t as usize).copied().unwrap_or(false))
     }
     let n = mesh.n_points() as u32;
+    let fixed = mesh.fixed_vertices();
     let mean_len: Vec<f64> = {
         let mesh = &*mesh;
         (0..n)
@@ -121,6 +127,7 @@ pub(crate) fn split_long_edges(
         let mesh = &*mesh;
         let mean_len = &mean_len;
         let zone = &zone;
+        let fixed = &fixed;
         (0..n)
             .into_par_iter()
             .with_min_len(1024)
@@ -133,7 +140,7 @@ pub(crate) fn split_long_edges(
                     for &b in nb.iter().filter(|&&b| b > a) {
                         let l = pa.distance(mesh.point(b));
                         let local = 0.5 * (mean_len[a as usize] + mean_len[b as usize]);
-                        if l > factor * local {
+                        if l > factor * local && !(fixed[a as usize] && fixed[b as usize]) {
                             shell(mesh, a, b, sh);
                             if sh.iter().all(|&t| in_zone(zone, t)) && is_free_edge(mesh, a, b, sh)
                             {
@@ -182,25 +189,35 @@ mod tests {
     use super::*;
     use crate::mesh::MeshData;
 
-    /// A bipyramid: the axis `a = (0,0,-3)`, `b = (0,0,3)` (length 6) and a
-    /// ring of six points on the unit circle, six tets around the axis. By
-    /// hand: the mean edge length is (6 + 6·√10)/7 ≈ 3.567 at `a` and `b`
-    /// and (2·√10 + 2)/4 ≈ 2.081 at a ring point, so with factor 1.4 only
-    /// the axis is long (6 > 4.99; a spoke √10 ≈ 3.16 < 1.4·2.82; a ring
-    /// edge 1 < 1.4·2.08).
+    /// A bipyramid with caps: the axis `a = (0,0,-3)`, `b = (0,0,3)`
+    /// (length 6) and a ring of six points on the unit circle make six tets
+    /// around the axis, and two apexes `(0,0,∓4)` cap them with six tets
+    /// each, so `a` and `b` are interior and the axis is a free edge. By
+    /// hand: the mean edge length is (6 + 1 + 6·√10)/8 ≈ 3.247 at `a` and
+    /// `b`, (1 + 6·√17)/7 ≈ 3.677 at an apex and (2·√10 + 2·√17 + 2)/6 ≈
+    /// 2.762 at a ring point, so with factor 1.4 only the axis is long
+    /// (6 > 4.55; a spoke √10 ≈ 3.16 < 1.4·3.00; an apex edge √17 ≈ 4.12 <
+    /// 1.4·3.22; a ring edge 1), and the axis stands 6/3.247 ≈ 1.85 times
+    /// over its local mean.
     fn bipyramid() -> TetMesh {
         let mut points = vec![[0.0, 0.0, -3.0], [0.0, 0.0, 3.0]];
         for i in 0..6 {
             let t = std::f64::consts::PI / 3.0 * i as f64;
             points.push([t.cos(), t.sin(), 0.0]);
         }
-        let tets = (0..6u32).map(|i| [0, 1, 2 + i, 2 + (i + 1) % 6]).collect();
+        points.extend([[0.0, 0.0, -4.0], [0.0, 0.0, 4.0]]);
+        let ring = |i: u32| 2 + i % 6;
+        let mut tets: Vec<[u32; 4]> = (0..6u32).map(|i| [0, 1, ring(i), ring(i + 1)]).collect();
+        tets.extend((0..6u32).map(|i| [8, 0, ring(i), ring(i + 1)]));
+        tets.extend((0..6u32).map(|i| [1, 9, ring(i), ring(i + 1)]));
         let data = MeshData {
             points,
             tets,
             ..Default::default()
         };
-        TetMesh::from_data(&data).expect("a valid bipyramid").0
+        TetMesh::from_data(&data)
+            .expect("a valid capped bipyramid")
+            .0
     }
 
     fn volume(m: &TetMesh) -> f64 {
@@ -212,19 +229,21 @@ mod tests {
     #[test]
     fn the_one_long_edge_is_split_at_its_midpoint() {
         let mut m = bipyramid();
-        // Six triangles of area √3/4 times the height 6, over three.
-        let exact = 6.0 * 3f64.sqrt() / 4.0 * 6.0 / 3.0;
+        // The hexagon (six triangles of area √3/4) times the heights
+        // 6 + 1 + 1, over three.
+        let exact = 6.0 * 3f64.sqrt() / 4.0 * 8.0 / 3.0;
         assert!((volume(&m) - exact).abs() < 1e-12);
         let (splits, new) = split_long_edges(&mut m, 1.4, 0.3, None);
         assert_eq!(splits, 1);
         // Every tet of the six-tet shell becomes two.
         assert_eq!(new.len(), 12);
-        assert_eq!(m.n_tets(), 12);
-        assert_eq!(m.n_points(), 9);
-        assert_eq!(m.point(8), glam::DVec3::ZERO);
+        assert_eq!(m.n_tets(), 24);
+        assert_eq!(m.n_points(), 11);
+        assert_eq!(m.point(10), glam::DVec3::ZERO);
         assert!((volume(&m) - exact).abs() < 1e-12);
         m.check().expect("a valid mesh after the split");
-        // Nothing is long any more at 1.4 (axis halves 3 against spokes √10).
+        // Nothing is long any more at 1.4: a half axis, 3, against
+        // 1.4·(2.872 + 1.5)/2 ≈ 3.06 (the means at `a` and at the midpoint).
         assert_eq!(split_long_edges(&mut m, 1.4, 0.3, None).0, 0);
     }
 
@@ -234,7 +253,7 @@ mod tests {
         let mut zone = vec![true; m.n_tet_slots()];
         zone[3] = false;
         assert_eq!(split_long_edges(&mut m, 1.4, 0.3, Some(&mut zone)).0, 0);
-        assert_eq!(m.n_tets(), 6);
+        assert_eq!(m.n_tets(), 18);
         let mut zone = vec![true; m.n_tet_slots()];
         let (splits, new) = split_long_edges(&mut m, 1.4, 0.3, Some(&mut zone));
         assert_eq!(splits, 1);
@@ -243,9 +262,24 @@ mod tests {
 
     #[test]
     fn a_higher_factor_splits_nothing() {
-        // The axis is 6 / 3.567 = 1.68 times its local mean.
+        // The axis is 1.85 times its local mean.
         let mut m = bipyramid();
-        assert_eq!(split_long_edges(&mut m, 1.7, 0.3, None).0, 0);
-        assert_eq!(split_long_edges(&mut m, 1.66, 0.3, None).0, 1);
+        assert_eq!(split_long_edges(&mut m, 1.9, 0.3, None).0, 0);
+        assert_eq!(split_long_edges(&mut m, 1.8, 0.3, None).0, 1);
+    }
+
+    #[test]
+    fn a_chord_between_boundary_points_stays() {
+        // Without its caps the axis joins two boundary points.
+        let mut m = bipyramid();
+        let tets: Vec<[u32; 4]> = (0..6).map(|t| m.tet(t)).collect();
+        let data = MeshData {
+            points: m.points().iter().map(|p| p.to_array()).collect(),
+            tets,
+            ..Default::default()
+        };
+        m = TetMesh::from_data(&data).expect("the uncapped bipyramid").0;
+        assert_eq!(split_long_edges(&mut m, 1.4, 0.3, None).0, 0);
+        assert_eq!(m.n_tets(), 6);
     }
 }

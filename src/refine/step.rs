@@ -169,14 +169,7 @@ pub fn refine_step_with_progress(
                     // a second round of passes, with edge removal up to a
                     // higher bar, settles the new balls.
                     report.improve = improve(mesh, &io);
-                    // Uniform steps only: after an adaptive step with splits, the
-                    // next step's optimize phase left a tripod selection along
-                    // its feature lines at 4.5° (11.8° without), not yet
-                    // understood.
-                    let factor = opts
-                        .effort
-                        .long_edge_factor()
-                        .filter(|_| opts.selection.is_none());
+                    let factor = opts.effort.long_edge_factor();
                     if let Some(factor) = factor {
                         let (movable, tet_allowed) = if opts.smooth_refined_only {
                             refined_zone(mesh, step)
