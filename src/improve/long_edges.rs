@@ -25,6 +25,7 @@
 
 use crate::geom::tet_min_sine;
 use crate::mesh::TetMesh;
+use crate::ops::edge_split::split_halves;
 use crate::ops::split_edge;
 use rayon::prelude::*;
 
@@ -51,43 +52,37 @@ fn is_free_edge(mesh: &TetMesh, a: u32, b: u32, sh: &[u32]) -> bool {
     !mesh.is_feature_edge(a, b)
         && sh.iter().all(|&t| {
             let v = mesh.tet(t);
-            let adj = mesh.adj(t);
             (0..4).all(|f| {
                 v[f] == a
                     || v[f] == b
-                    || (adj[f] != crate::mesh::NO_ADJ && !mesh.is_interface_face(t, f))
+                    || !(mesh.is_boundary_face(t, f) || mesh.is_interface_face(t, f))
             })
         })
 }
 
 /// Worst quality (min sine) of the shell of `(a, b)` as it stands, and of the
-/// two halves of every shell tet with `p` in place of `b` and of `a`.
+/// halves of its tets when the edge is split at `p` ([`split_halves`]).
 fn shell_qualities(mesh: &TetMesh, a: u32, b: u32, p: glam::DVec3, sh: &[u32]) -> (f64, f64) {
     let mut old = f64::INFINITY;
     let mut new = f64::INFINITY;
     for &t in sh {
         let v = mesh.tet(t);
-        let pts = mesh.tet_points(t);
-        old = old.min(tet_min_sine(&pts));
-        for replaced in [b, a] {
-            let mut q = pts;
-            let i = v
-                .iter()
-                .position(|&x| x == replaced)
-                .expect("a shell tet holds both ends of its edge");
-            q[i] = p;
+        old = old.min(tet_min_sine(&mesh.tet_points(t)));
+        for half in split_halves(v, a, b, u32::MAX) {
+            let q = half.map(|x| if x == u32::MAX { p } else { mesh.point(x) });
             new = new.min(tet_min_sine(&q));
         }
     }
     (old, new)
 }
 
-/// Splits every free interior edge that is not a chord (see the module doc) longer than `factor` times the mean edge length at its
-/// two ends (see the module doc), longest first, at its midpoint. An edge
-/// is split only when every tet of its shell is in `zone` (per tet slot;
-/// `None`: every tet; the new tets join it) and when the worst of the new tets is at least the
-/// smaller of the shell's worst and `bar` (min sine), so the pass never
-/// lowers the worst tet below `bar`. Returns the number of edges split and
+/// Splits every free interior edge that is not a chord (see the module doc)
+/// longer than `factor` times the mean edge length at its two ends, longest
+/// first, at its midpoint. An edge is split only when every tet of its shell
+/// is in `zone` (per tet slot; `None`: every tet; the new tets join it) and
+/// when the worst of the new tets is at least the smaller of the shell's
+/// worst and `bar` (min sine), so the pass never lowers the worst tet below
+/// `bar`. Returns the number of edges split and
 /// the new tets.
 ///
 /// The candidates are found in parallel and split in one fixed order

@@ -26,6 +26,19 @@ use crate::geom::is_positive;
 use crate::mesh::TetMesh;
 use glam::DVec3;
 
+/// The two halves of a shell tet `v` of edge `(a, b)` split at vertex `m`:
+/// `v` with `b` replaced by `m`, then with `a` replaced by `m` (the
+/// substitution keeps the orientation; see the sketch above).
+pub(crate) fn split_halves(v: [u32; 4], a: u32, b: u32, m: u32) -> [[u32; 4]; 2] {
+    let ia = v.iter().position(|&x| x == a).expect("a shell tet holds a");
+    let ib = v.iter().position(|&x| x == b).expect("a shell tet holds b");
+    let mut t1 = v;
+    t1[ib] = m;
+    let mut t2 = v;
+    t2[ia] = m;
+    [t1, t2]
+}
+
 /// Splits the edge `(a, b)` at `p` (a point near its midpoint): every tet
 /// holding the edge (found through the ball of `a`, so several fans of a
 /// non-manifold edge are all split) becomes two, each keeping its tet's
@@ -53,13 +66,8 @@ pub fn split_edge(
     let mut others: Vec<u32> = Vec::new();
     for (i, &t) in around.iter().enumerate() {
         let v = mesh.tet(t);
-        let ia = v.iter().position(|&x| x == a).expect("the ball of a");
-        let ib = v.iter().position(|&x| x == b).expect("retained for b");
-        let mut t1 = v;
-        t1[ib] = u32::MAX; // m, once it has an id
-        let mut t2 = v;
-        t2[ia] = u32::MAX;
-        new.extend([t1, t2]);
+        // m, once it has an id
+        new.extend(split_halves(v, a, b, u32::MAX));
         origin.extend([i, i]);
         others.extend(v.iter().copied().filter(|&x| x != a && x != b));
     }

@@ -6,6 +6,7 @@
 //! are refused with file and line, and nothing is written.
 
 use std::path::Path;
+use std::process::Output;
 use tetrefine::io::load_mesh;
 
 fn f(p: [f64; 3]) -> f64 {
@@ -74,12 +75,12 @@ struct Vtu {
     cell: Vec<(String, usize, Vec<f64>)>,
 }
 
-/// One linear-rule step of the tripod into `out`, carrying the fields of
-/// [`fields`].
-fn refine_tripod_with_fields(out: &Path) {
+/// Linear-rule refinement of the tripod into `out`, carrying the fields of
+/// [`fields`], with `extra` options (one step without).
+fn refine_tripod_with_fields(out: &Path, extra: &[&str]) -> Output {
     let inputs = tempfile::tempdir().unwrap();
     let (fp, cp) = fields(inputs.path());
-    ok(&[
+    let mut args = vec![
         "refine",
         "meshes/tripod.mesh",
         "-o",
@@ -90,7 +91,9 @@ fn refine_tripod_with_fields(out: &Path) {
         &fp,
         "--fields",
         &cp,
-    ]);
+    ];
+    args.extend_from_slice(extra);
+    ok(&args)
 }
 
 fn read_vtu(path: &Path) -> Vtu {
@@ -130,27 +133,13 @@ fn array<'a>(a: &'a [(String, usize, Vec<f64>)], name: &str) -> &'a (String, usi
 
 #[test]
 fn sol_fields_through_two_steps_in_the_vtu_and_the_parent_map() {
-    let inputs = tempfile::tempdir().unwrap();
-    let (fp, cp) = fields(inputs.path());
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("out.vtu");
     let map = dir.path().join("map.txt");
-    let o = ok(&[
-        "refine",
-        "meshes/tripod.mesh",
-        "-o",
-        out.to_str().unwrap(),
-        "--steps",
-        "2",
-        "--boundary",
-        "linear",
-        "--fields",
-        &fp,
-        "--fields",
-        &cp,
-        "--parent-map",
-        map.to_str().unwrap(),
-    ]);
+    let o = refine_tripod_with_fields(
+        &out,
+        &["--steps", "2", "--parent-map", map.to_str().unwrap()],
+    );
     assert!(
         String::from_utf8_lossy(&o.stderr).contains("transfer: 2 point and 1 cell fields"),
         "{}",
@@ -212,7 +201,7 @@ fn sol_fields_through_two_steps_in_the_vtu_and_the_parent_map() {
 fn fields_come_back_from_a_vtu_input_and_in_gmsh_and_medit_outputs() {
     let dir = tempfile::tempdir().unwrap();
     let step1 = dir.path().join("step1.vtu");
-    refine_tripod_with_fields(&step1);
+    refine_tripod_with_fields(&step1, &[]);
     // Its point and cell data are the second step's fields (the derived
     // arrays — quality, parent, the parent map — are not).
     for out in ["step2.msh", "step2.mesh"] {
@@ -342,7 +331,7 @@ fn meshio_reads_the_transferred_fields() {
     }
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("o.vtu");
-    refine_tripod_with_fields(&out);
+    refine_tripod_with_fields(&out, &[]);
     let script = r#"
 import sys, meshio, numpy as np
 m = meshio.read(sys.argv[1])
