@@ -190,19 +190,19 @@ pub(crate) fn l_prism() -> PolyMesh {
 /// base scaled towards a random apex, so every face is planar and every vertex
 /// 3-valent.
 pub(crate) fn random_frustum(seed: u64, sides: usize) -> PolyMesh {
-    let mut rng = TestRng(seed);
+    let mut rng = tetrefine::SplitMix64(seed);
     let mut angles: Vec<f64> = (0..sides)
-        .map(|_| rng.next() * std::f64::consts::TAU)
+        .map(|_| rng.next_f64() * std::f64::consts::TAU)
         .collect();
     angles.sort_by(f64::total_cmp);
     let base: Vec<DVec3> = angles
         .iter()
-        .map(|&a| DVec3::new(a.cos(), a.sin(), 0.0) * (0.7 + 0.6 * rng.next()))
+        .map(|&a| DVec3::new(a.cos(), a.sin(), 0.0) * (0.7 + 0.6 * rng.next_f64()))
         .collect();
     // Convex hull order is the angle order only for a star-shaped polygon;
     // keep it star-shaped (planar faces are all that matter here).
-    let apex = DVec3::new(rng.next() - 0.5, rng.next() - 0.5, 1.5 + rng.next());
-    let s = 0.3 + 0.4 * rng.next();
+    let apex = DVec3::new(rng.next_f64() - 0.5, rng.next_f64() - 0.5, 1.5 + rng.next_f64());
+    let s = 0.3 + 0.4 * rng.next_f64();
     let top: Vec<DVec3> = base.iter().map(|&b| apex + s * (b - apex)).collect();
     prism(&base, &top)
 }
@@ -441,19 +441,4 @@ pub(crate) fn signed_volume(mesh: &PolyMesh) -> f64 {
         })
         .sum::<f64>()
         / 6.0
-}
-
-/// A small deterministic generator for test shapes (xorshift64*).
-pub(crate) struct TestRng(pub u64);
-
-impl TestRng {
-    /// Uniform in [0, 1).
-    pub(crate) fn next(&mut self) -> f64 {
-        let mut x = self.0 | 1;
-        x ^= x >> 12;
-        x ^= x << 25;
-        x ^= x >> 27;
-        self.0 = x;
-        (x.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 11) as f64 / (1u64 << 53) as f64
-    }
 }
