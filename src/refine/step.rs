@@ -407,6 +407,9 @@ fn boundary_flip_phase(
     let even = st.step % 2 == 0;
     let mut ball = Vec::new();
     let mut marks = TetMarks::default();
+    if even {
+        trisect_interior_features(mesh, st, &seen_count, report);
+    }
     let mut ring = EdgeRing::default();
     for ([a, b], m) in edges {
         let is_feature = mesh.is_feature_edge(a, b);
@@ -479,6 +482,48 @@ fn boundary_flip_phase(
         };
         match result {
             Ok(()) => report.boundary_flipped += 1,
+            Err(_) => report.refused_boundary_flips += 1,
+        }
+    }
+}
+
+/// The interior half of phase 4 in even steps: every feature edge on no
+/// constrained face (a tagged edge inside a region, a feature line running
+/// from the boundary through the interior) whose tets were all refined in
+/// this step is trisected at exact thirds, as the boundary's creases are
+/// (the √3 paper, §5, treats tagged interior edges the same way). The √3
+/// split and flip keep every old edge, so such an edge is still there; in an
+/// adaptive step, an edge with an unrefined tet around it is kept until its
+/// whole ball is refined.
+fn trisect_interior_features(
+    mesh: &mut TetMesh,
+    st: &mut StepState,
+    on_constrained_faces: &FastHashMap<[u32; 2], u8>,
+    report: &mut StepReport,
+) {
+    let mut edges: Vec<[u32; 2]> = mesh
+        .feature_edges()
+        .keys()
+        .filter(|k| !on_constrained_faces.contains_key(*k))
+        .copied()
+        .collect();
+    edges.sort_unstable();
+    let (mut ball, mut marks) = (Vec::new(), TetMarks::default());
+    for [a, b] in edges {
+        mesh.ball_marked(a, &mut ball, &mut marks);
+        ball.retain(|&u| mesh.tet(u).contains(&b));
+        let refined = |u: &u32| mesh.tet(*u).iter().any(|&v| v >= st.first_barycentre);
+        if ball.is_empty() || !ball.iter().all(refined) {
+            report.kept_feature_edges += 1;
+            continue;
+        }
+        let (pa, pb) = (mesh.point(a), mesh.point(b));
+        let (x1, x2) = (pa + (pb - pa) / 3.0, pa + (pb - pa) * (2.0 / 3.0));
+        match trisect_edge(mesh, a, b, &ball, x1, x2) {
+            Ok(_) => {
+                report.trisected_feature_edges += 1;
+                st.trisected.insert([a, b]);
+            }
             Err(_) => report.refused_boundary_flips += 1,
         }
     }

@@ -53,6 +53,44 @@ fn l_block() -> TetMesh {
     m
 }
 
+/// The unit cube (`cube_grid(4)`) in two regions: region 2 is the column
+/// x, y > 1/2, so the interface bends by 90° along the interior line
+/// x = y = 1/2 (a crease of the interface, from the bottom face to the top).
+/// A second line, x = y = 1/4 inside region 1, is tagged by hand: a feature
+/// line through the interior on no constrained face, ending on the boundary.
+fn block_with_interior_lines() -> TetMesh {
+    let g = cube_grid(4);
+    let centroid = |t: &[u32; 4]| {
+        t.iter()
+            .map(|&v| DVec3::from_array(g.points[v as usize]))
+            .sum::<DVec3>()
+            / 4.0
+    };
+    let regions = g
+        .tets
+        .iter()
+        .map(|t| {
+            let c = centroid(t);
+            if c.x > 0.5 && c.y > 0.5 {
+                2
+            } else {
+                1
+            }
+        })
+        .collect();
+    let data = MeshData {
+        tet_regions: regions,
+        ..g
+    };
+    let (mut m, _) = TetMesh::from_data(&data).unwrap();
+    // Point (i, j, k) of cube_grid(4) has id i + 5 (j + 5 k).
+    let id = |i: u32, j: u32, k: u32| i + 5 * (j + 5 * k);
+    for k in 0..4 {
+        m.set_feature_edge(id(1, 1, k), id(1, 1, k + 1), Some(7));
+    }
+    m
+}
+
 fn region_volumes(m: &TetMesh) -> BTreeMap<i32, f64> {
     let mut v = BTreeMap::new();
     for t in m.tet_ids() {
@@ -174,7 +212,11 @@ fn piecewise_planar_domains_keep_volumes_planes_and_corners() {
 
 #[test]
 fn feature_edges_are_kept_in_step_1_and_trisected_in_step_2() {
-    for (name, input) in [("mmg_cube", load("mmg_cube.mesh")), ("l_block", l_block())] {
+    for (name, input) in [
+        ("mmg_cube", load("mmg_cube.mesh")),
+        ("l_block", l_block()),
+        ("block with interior lines", block_with_interior_lines()),
+    ] {
         let mut m = input.clone();
         detect_features(&mut m, 45.0);
         let segs0 = feature_segments(&m);

@@ -201,7 +201,11 @@ pub(crate) fn random_frustum(seed: u64, sides: usize) -> PolyMesh {
         .collect();
     // Convex hull order is the angle order only for a star-shaped polygon;
     // keep it star-shaped (planar faces are all that matter here).
-    let apex = DVec3::new(rng.next_f64() - 0.5, rng.next_f64() - 0.5, 1.5 + rng.next_f64());
+    let apex = DVec3::new(
+        rng.next_f64() - 0.5,
+        rng.next_f64() - 0.5,
+        1.5 + rng.next_f64(),
+    );
     let s = 0.3 + 0.4 * rng.next_f64();
     let top: Vec<DVec3> = base.iter().map(|&b| apex + s * (b - apex)).collect();
     prism(&base, &top)
