@@ -58,7 +58,9 @@ fn l_block() -> TetMesh {
 /// x = y = 1/2 (a crease of the interface, from the bottom face to the top).
 /// A second line, x = y = 1/4 inside region 1, is tagged by hand: a feature
 /// line through the interior on no constrained face, ending on the boundary.
-fn block_with_interior_lines() -> TetMesh {
+/// With `three`, the column x < 1/2 < y is region 3, and the first line is
+/// where three regions meet instead.
+fn block_with_interior_lines(three: bool) -> TetMesh {
     let g = cube_grid(4);
     let centroid = |t: &[u32; 4]| {
         t.iter()
@@ -73,6 +75,8 @@ fn block_with_interior_lines() -> TetMesh {
             let c = centroid(t);
             if c.x > 0.5 && c.y > 0.5 {
                 2
+            } else if three && c.y > 0.5 {
+                3
             } else {
                 1
             }
@@ -215,11 +219,20 @@ fn feature_edges_are_kept_in_step_1_and_trisected_in_step_2() {
     for (name, input) in [
         ("mmg_cube", load("mmg_cube.mesh")),
         ("l_block", l_block()),
-        ("block with interior lines", block_with_interior_lines()),
+        ("block, interface crease", block_with_interior_lines(false)),
+        ("block, three regions", block_with_interior_lines(true)),
     ] {
         let mut m = input.clone();
         detect_features(&mut m, 45.0);
         let segs0 = feature_segments(&m);
+        if name.starts_with("block") {
+            // Both interior lines are features: 4 segments each.
+            for c in [0.25, 0.5] {
+                let on = |p: &DVec3| p.x == c && p.y == c;
+                let n = segs0.iter().filter(|s| s.iter().all(on)).count();
+                assert_eq!(n, 4, "{name}: line x = y = {c}");
+            }
+        }
         let key = |s: &[DVec3; 2]| {
             let (a, b) = (bits(s[0]), bits(s[1]));
             if a < b {
