@@ -71,7 +71,7 @@ pub use polyline::{
     write_polylines_vtp, PolylineFormat,
 };
 pub use refine::bisect::{bisect, bisect_steps, BisectError};
-pub use refine::features::detect_features;
+pub use refine::features::{detect_features, detect_features_for};
 pub use refine::marking::{doerfler_count, fraction_count, ranking, select, MarkStrategy};
 pub use refine::parents::{contains, walk_to};
 pub use refine::size::{
@@ -80,8 +80,8 @@ pub use refine::size::{
 };
 pub use refine::{
     copy_cell_field, interpolate_point_field, locate_parents, locate_points, refine, refine_step,
-    refine_step_with_progress, refine_with, refine_with_guard, NoProgress, Phase, PhaseReport,
-    PointParent, Progress, RefineOptions, StepReport,
+    refine_step_with_progress, refine_with, refine_with_guard, InterfaceRule, NoProgress, Phase,
+    PhaseReport, PointParent, Progress, RefineOptions, StepReport,
 };
 pub use report::{format_table, write_histogram, MeshStats};
 pub use rng::SplitMix64;

@@ -281,6 +281,8 @@ pub struct RefineArgs {
     pub effort: String,
     /// `--hausd`.
     pub hausd: Option<f64>,
+    /// `--interfaces linear|sqrt3`.
+    pub interfaces: String,
     /// `--steps auto` (then `steps` is the cap, [`AUTO_SIZE_PASSES`]).
     pub steps_auto: bool,
     /// `--size` / `--size-array`: components (1 or 6) and values per point.
@@ -476,6 +478,10 @@ pub fn refine(
         .boundary
         .parse()
         .map_err(|e| Value(format!("boundary: {e}")))?;
+    let interfaces: tetrefine::InterfaceRule = a
+        .interfaces
+        .parse()
+        .map_err(|e| Value(format!("interfaces: {e}")))?;
     let stop_after = match &a.stop_after {
         Some(p) => Some(
             p.parse::<Phase>()
@@ -550,12 +556,12 @@ pub fn refine(
     let mut mesh = input.clone();
     let t_copy = lap();
     {
-        use tetrefine::detect_features;
+        use tetrefine::detect_features_for;
         use tetrefine::io::read_edge_list;
         match a.features.as_str() {
             "none" => mesh.clear_features(),
             "auto" => {
-                detect_features(&mut mesh, a.feature_angle);
+                detect_features_for(&mut mesh, a.feature_angle, interfaces);
             }
             file => {
                 read_edge_list(&mut mesh, Path::new(file)).map_err(|e| File(e.to_string()))?;
@@ -582,6 +588,7 @@ pub fn refine(
             }
             h => h,
         },
+        interfaces,
     };
     let progress = HookProgress {
         hook,

@@ -689,6 +689,9 @@ impl Mesh {
     ///                 sliver caps removed) or 'best' [--effort].
     ///   hausd         Hausdorff bound of boundary moves (MMG's -hausd);
     ///                 None: 5 % of the local edge length [--hausd].
+    ///   interfaces    'linear' (material interfaces split flat, exact
+    ///                 region volumes) or 'sqrt3' (smoothed on both sides by
+    ///                 the boundary rule) [--interfaces].
     ///
     /// The GIL is released while the mesh is refined. Ctrl-C (SIGINT) stops
     /// the run at the start of the next phase and raises KeyboardInterrupt.
@@ -701,8 +704,8 @@ impl Mesh {
                      step_offset=0, progress=None, stats=false, allow_empty=false,
                      allow_steps_zero=false, point_fields=None, cell_fields=None,
                      transfer=None, vertex_parents=false, size=None, hsiz=None, hmax=None,
-                     effort="default", hausd=None),
-        text_signature = "(self, steps=None, *, boundary='interpolating', opt_passes=3, threshold=0.3, stop_after=None, features='auto', feature_angle=45.0, indicator=None, mark='doerfler:0.5', region=None, box=None, sphere=None, smooth='refined', step_offset=0, progress=False, stats=False, allow_empty=False, allow_steps_zero=False, point_fields=None, cell_fields=None, transfer=None, vertex_parents=False, size=None, hsiz=None, hmax=None, effort='default', hausd=None)"
+                     effort="default", hausd=None, interfaces="linear"),
+        text_signature = "(self, steps=None, *, boundary='interpolating', opt_passes=3, threshold=0.3, stop_after=None, features='auto', feature_angle=45.0, indicator=None, mark='doerfler:0.5', region=None, box=None, sphere=None, smooth='refined', step_offset=0, progress=False, stats=False, allow_empty=False, allow_steps_zero=False, point_fields=None, cell_fields=None, transfer=None, vertex_parents=False, size=None, hsiz=None, hmax=None, effort='default', hausd=None, interfaces='linear')"
     )]
     #[allow(clippy::too_many_arguments)]
     fn refine(
@@ -735,6 +738,7 @@ impl Mesh {
         hmax: Option<f64>,
         effort: &str,
         hausd: Option<f64>,
+        interfaces: &str,
     ) -> PyResult<Mesh> {
         let this = slf.get();
         let size = match size {
@@ -816,6 +820,7 @@ impl Mesh {
             vertex_parents,
             effort: effort.to_string(),
             hausd,
+            interfaces: interfaces.to_string(),
         };
         // progress: None/False, True (lines on stderr) or a callable.
         let (print, callback): (bool, Option<Py<PyAny>>) = match progress {

@@ -88,6 +88,18 @@ def test_refine_options_equal_cli(tmp_path, cli, cli_json):
     assert [p["name"] for p in fine.reports[0]["phases"]][-1] == "boundary-smooth"
 
 
+def test_sqrt3_interfaces_equal_cli(tmp_path, cli, cli_json):
+    src = MESHES / "gmsh_t16.mesh"
+    out = tmp_path / "o.mesh"
+    cli("refine", src, "-o", out, "--interfaces", "sqrt3", "--effort", "fast")
+    fine = tetrefine.read(src).refine(interfaces="sqrt3", effort="fast")
+    assert fine.quality() == cli_json(out)
+    # The curved inclusions are no creases under sqrt3 (only the box's
+    # 219 edges sharper than 45 degrees are), unlike under linear.
+    linear = tetrefine.read(src).refine(effort="fast", stop_after="split")
+    assert fine.quality()["feature_edges"] < linear.quality()["feature_edges"]
+
+
 def test_improve_and_bisect_equal_cli(tmp_path, cli, cli_json):
     src = MESHES / "tetgen_example.mesh"
     imp, bis = tmp_path / "i.mesh", tmp_path / "b.mesh"

@@ -105,6 +105,7 @@ def test_bad_options():
         (dict(box=[0, 0, 0]), "box:x0,y0,z0,x1,y1,z1 needs 6 comma-separated numbers, found 3"),
         (dict(sphere=[0, 0, 0, -1]), "sphere"),
         (dict(boundary="cubic"), "unknown boundary rule 'cubic'"),
+        (dict(interfaces="smooth"), "unknown interface rule 'smooth'; one of linear, sqrt3"),
         (dict(stop_after="later"), "unknown phase 'later'"),
         (dict(threshold=1.5), r"threshold=1.5 must lie in \(0, 1\)"),
         (dict(feature_angle=0), r"feature_angle=0 must lie in \(0, 180\)"),

@@ -9,7 +9,8 @@
 //!   different region pairs);
 //! * the normals of its two faces differ by more than the feature angle (45° by
 //!   default, MMG's ridge angle);
-//! * it lies on a material interface whose two faces there are not coplanar.
+//! * it lies on a material interface whose two faces there are not coplanar
+//!   (with linear interfaces, [`InterfaceRule::Linear`], the default).
 //!   A √3 flip of such an edge would cut a chord through one region into the
 //!   other, so curved interfaces are refined by the crease rule instead and
 //!   every region stays exactly what it was.
@@ -18,6 +19,7 @@
 //! at least one), plus those tagged in the input. Tags read from the input
 //! (Medit `Edges`/`Ridges`, `Corners`, `RequiredVertices`) are kept.
 
+use super::InterfaceRule;
 use crate::file::IoError;
 use crate::mesh::{edge_key, TetMesh, NO_ADJ};
 use glam::DVec3;
@@ -84,8 +86,21 @@ pub struct FeatureReport {
 }
 
 /// Tags feature edges (with marker 0 when new) and corners on `mesh` by the
-/// rules of the module docs, keeping the tags already there.
+/// rules of the module docs, keeping the tags already there; for linear
+/// interfaces ([`detect_features_for`] with [`InterfaceRule::Linear`]).
 pub fn detect_features(mesh: &mut TetMesh, angle_deg: f64) -> FeatureReport {
+    detect_features_for(mesh, angle_deg, InterfaceRule::Linear)
+}
+
+/// [`detect_features`] for the interface rule the refinement will use: with
+/// [`InterfaceRule::Sqrt3`] a bending interface is no crease by itself (the
+/// √3 rule refines it as a smooth surface); only the angle, patch and
+/// junction rules tag its edges.
+pub fn detect_features_for(
+    mesh: &mut TetMesh,
+    angle_deg: f64,
+    interfaces: InterfaceRule,
+) -> FeatureReport {
     let faces = constrained_faces(mesh);
     let mut by_edge: HashMap<[u32; 2], Vec<SideFace>> = HashMap::new();
     for (fv, patch) in &faces {
@@ -123,7 +138,10 @@ pub fn detect_features(mesh: &mut TetMesh, angle_deg: f64) -> FeatureReport {
             // Consistently oriented neighbours: the normal deviation is the
             // angle between the normals.
             Some(&mut report.by_angle)
-        } else if sides[0].patch.0 != i64::MIN && !coplanar(mesh, e, sides) {
+        } else if interfaces == InterfaceRule::Linear
+            && sides[0].patch.0 != i64::MIN
+            && !coplanar(mesh, e, sides)
+        {
             Some(&mut report.curved_interface)
         } else {
             None

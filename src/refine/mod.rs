@@ -114,6 +114,39 @@ impl FromStr for Phase {
     }
 }
 
+/// How material interfaces (faces between two regions) are refined
+/// (`--interfaces`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum InterfaceRule {
+    /// Interface faces are split at their centroids and flipped only where
+    /// flat, and interface points never move in the topological phases: every
+    /// region keeps its exact volume, and a curved interface is tagged as
+    /// creases wherever it bends ([`features::detect_features`]), so it stays
+    /// faceted at its input resolution. The default.
+    #[default]
+    Linear,
+    /// Interface faces are split and flipped by the √3 rule on both sides, and
+    /// interface points move by the boundary's stencil ([`Sqrt3Rule`]):
+    /// a curved interface converges to a smooth surface. Only bends sharper
+    /// than the feature angle (and junctions) stay creases. Region volumes
+    /// change by the smoothing (bounded in the README's measurements). Faces
+    /// marked inside one region stay linear.
+    Sqrt3,
+}
+
+impl FromStr for InterfaceRule {
+    type Err = String;
+    fn from_str(s: &str) -> Result<InterfaceRule, String> {
+        match s {
+            "linear" => Ok(InterfaceRule::Linear),
+            "sqrt3" => Ok(InterfaceRule::Sqrt3),
+            _ => Err(format!(
+                "unknown interface rule '{s}'; one of linear, sqrt3"
+            )),
+        }
+    }
+}
+
 /// Options of a refinement step.
 #[derive(Clone, Debug)]
 pub struct RefineOptions {
@@ -146,6 +179,10 @@ pub struct RefineOptions {
     /// Hausdorff bound of boundary moves (`--hausd`; `None`: relative to the
     /// local edge length).
     pub hausd: Option<f64>,
+    /// How material interfaces are refined (`--interfaces`). Feature
+    /// detection must agree: [`features::detect_features_for`] with the same
+    /// rule.
+    pub interfaces: InterfaceRule,
 }
 
 impl Default for RefineOptions {
@@ -161,6 +198,7 @@ impl Default for RefineOptions {
             check_each_phase: false,
             effort: crate::improve::Effort::Default,
             hausd: None,
+            interfaces: InterfaceRule::Linear,
         }
     }
 }

@@ -1,6 +1,6 @@
 //! The phases of one √3 step (see the module docs of [`crate::refine`]).
 
-use super::{NoProgress, Phase, PhaseReport, Progress, RefineOptions, StepReport};
+use super::{InterfaceRule, NoProgress, Phase, PhaseReport, Progress, RefineOptions, StepReport};
 use crate::improve::{improve, ImproveOptions};
 use crate::mesh::ball_stays_positive;
 use crate::mesh::fasthash::FastHashMap;
@@ -90,6 +90,10 @@ struct StepState {
     /// Old interface faces (between regions, or marked) that were split, with
     /// their new point.
     split_interfaces: Vec<([u32; 3], u32)>,
+    /// Those of `split_interfaces` that lie between two regions, oriented
+    /// outward from the lower region (one orientation per interface patch,
+    /// as the √3 stencils need).
+    region_interfaces: Vec<([u32; 3], u32)>,
     /// 1-based step number: feature edges are kept in odd steps and trisected
     /// in even ones.
     step: usize,
@@ -119,6 +123,7 @@ pub fn refine_step_with_progress(
         first_face_point: u32::MAX,
         split_faces: Vec::new(),
         split_interfaces: Vec::new(),
+        region_interfaces: Vec::new(),
         step: step + opts.step_offset,
         creases: mesh.feature_edges().keys().copied().collect(),
         trisected: HashSet::new(),
@@ -134,6 +139,7 @@ pub fn refine_step_with_progress(
                 mesh,
                 &mut st,
                 opts.boundary == crate::stencil::Sqrt3Rule::Linear,
+                opts.interfaces == InterfaceRule::Sqrt3,
                 &mut report,
             ),
             Phase::BoundarySmooth => boundary_smooth_phase(mesh, &st, opts, &mut report),
@@ -303,8 +309,15 @@ fn boundary_split_phase(mesh: &mut TetMesh, st: &mut StepState, report: &mut Ste
         let fv = mesh.face_vertices(t, f);
         let p = fv.map(|x| mesh.point(x));
         let c = (p[0] + p[1] + p[2]) / 3.0;
+        let (rt, ru) = (mesh.region(t), mesh.region(mesh.adj(t)[f] >> 2));
         if let Ok(m) = split_interface_face(mesh, t, f, c) {
             st.split_interfaces.push((fv, m));
+            if rt != ru {
+                // `fv` is seen from `t`, outward: reversed when `t` is on the
+                // higher side.
+                let oriented = if rt < ru { fv } else { [fv[0], fv[2], fv[1]] };
+                st.region_interfaces.push((oriented, m));
+            }
             report.interface_split += 1;
         }
     }
@@ -372,11 +385,14 @@ fn flat_enough(mesh: &TetMesh, a: u32, b: u32, m1: u32, m2: u32) -> bool {
 /// exactly, a boundary edge is flipped only where its two old faces are
 /// exactly coplanar (exact `orient3d` of the edge and their opposite
 /// corners is zero): across any bend, however slight, the new edge between
-/// the face points would cut the domain.
+/// the face points would cut the domain. Interface edges likewise, unless
+/// `sqrt3_interfaces`: then an edge between two regions is flipped however
+/// its interface bends (the stencils of phase 5 then move both sides).
 fn boundary_flip_phase(
     mesh: &mut TetMesh,
     st: &mut StepState,
     linear: bool,
+    sqrt3_interfaces: bool,
     report: &mut StepReport,
 ) {
     let fp = st.first_face_point;
@@ -430,17 +446,8 @@ fn boundary_flip_phase(
         }
         if is_feature {
             // Every tet holding the edge, over all its fans.
-            mesh.ball_marked(a, &mut ball, &mut marks);
-            ball.retain(|&u| mesh.tet(u).contains(&b));
-            let (pa, pb) = (mesh.point(a), mesh.point(b));
-            let (x1, x2) = (pa + (pb - pa) / 3.0, pa + (pb - pa) * (2.0 / 3.0));
-            match trisect_edge(mesh, a, b, &ball, x1, x2) {
-                Ok(_) => {
-                    report.trisected_feature_edges += 1;
-                    st.trisected.insert([a, b]);
-                }
-                Err(_) => report.refused_boundary_flips += 1,
-            }
+            tets_of_edge(mesh, a, b, &mut ball, &mut marks);
+            trisect_at_thirds(mesh, st, [a, b], &ball, report);
             continue;
         }
         if cons.len() != 2 || seen_count[&[a, b]] != 2 {
@@ -451,9 +458,16 @@ fn boundary_flip_phase(
             continue;
         }
         let result = if ring.closed {
-            // Only a flat interface may be flipped: across a bend, the new
-            // edge would cut a chord from one region into the other.
-            if !flat_enough(mesh, a, b, cons[0], cons[1]) {
+            // Only a flat interface may be flipped under the linear rule:
+            // across a bend, the new edge would cut a chord from one region
+            // into the other. A marked face inside one region stays linear
+            // under both rules.
+            let between_regions = {
+                let r0 = mesh.region(ring.tets[0]);
+                ring.tets.iter().any(|&u| mesh.region(u) != r0)
+            };
+            let smooth = sqrt3_interfaces && between_regions;
+            if !smooth && !flat_enough(mesh, a, b, cons[0], cons[1]) {
                 report.refused_boundary_flips += 1;
                 continue;
             }
@@ -510,38 +524,56 @@ fn trisect_interior_features(
     edges.sort_unstable();
     let (mut ball, mut marks) = (Vec::new(), TetMarks::default());
     for [a, b] in edges {
-        mesh.ball_marked(a, &mut ball, &mut marks);
-        ball.retain(|&u| mesh.tet(u).contains(&b));
+        tets_of_edge(mesh, a, b, &mut ball, &mut marks);
         let refined = |u: &u32| mesh.tet(*u).iter().any(|&v| v >= st.first_barycentre);
         if ball.is_empty() || !ball.iter().all(refined) {
             report.kept_feature_edges += 1;
             continue;
         }
-        let (pa, pb) = (mesh.point(a), mesh.point(b));
-        let (x1, x2) = (pa + (pb - pa) / 3.0, pa + (pb - pa) * (2.0 / 3.0));
-        match trisect_edge(mesh, a, b, &ball, x1, x2) {
-            Ok(_) => {
-                report.trisected_feature_edges += 1;
-                st.trisected.insert([a, b]);
-            }
-            Err(_) => report.refused_boundary_flips += 1,
+        trisect_at_thirds(mesh, st, [a, b], &ball, report);
+    }
+}
+
+/// Every tet holding the edge `(a, b)`, over all its fans, into `out`.
+fn tets_of_edge(mesh: &TetMesh, a: u32, b: u32, out: &mut Vec<u32>, marks: &mut TetMarks) {
+    mesh.ball_marked(a, out, marks);
+    out.retain(|&u| mesh.tet(u).contains(&b));
+}
+
+/// Trisects the feature edge `[a, b]` (its tets `around`) with new points at
+/// exactly 1/3 and 2/3, and records it in the step and the report.
+fn trisect_at_thirds(
+    mesh: &mut TetMesh,
+    st: &mut StepState,
+    [a, b]: [u32; 2],
+    around: &[u32],
+    report: &mut StepReport,
+) {
+    let (pa, pb) = (mesh.point(a), mesh.point(b));
+    let (x1, x2) = (pa + (pb - pa) / 3.0, pa + (pb - pa) * (2.0 / 3.0));
+    match trisect_edge(mesh, a, b, around, x1, x2) {
+        Ok(_) => {
+            report.trisected_feature_edges += 1;
+            st.trisected.insert([a, b]);
         }
+        Err(_) => report.refused_boundary_flips += 1,
     }
 }
 
 /// Phase 5: the √3 stencils on the old boundary points and the new face
-/// points; each move is checked against inversion and halved (up to six
-/// times) or skipped.
+/// points (and, with `--interfaces sqrt3`, on the interfaces between regions,
+/// each seen from its lower region); each move is checked against inversion
+/// and halved (up to six times) or skipped.
 fn boundary_smooth_phase(
     mesh: &mut TetMesh,
     st: &StepState,
     opts: &RefineOptions,
     report: &mut StepReport,
 ) {
-    if st.split_faces.is_empty() {
+    let sqrt3_interfaces = opts.interfaces == InterfaceRule::Sqrt3;
+    if st.split_faces.is_empty() && (!sqrt3_interfaces || st.region_interfaces.is_empty()) {
         return;
     }
-    let tris: Vec<[u32; 3]> = st.split_faces.iter().map(|(f, _)| *f).collect();
     let creases = &st.creases;
     let corners: HashSet<u32> = mesh
         .corners()
@@ -549,40 +581,44 @@ fn boundary_smooth_phase(
         .chain(mesh.required_vertices())
         .copied()
         .collect();
-    // The trisected variant places the face points of faces along a
-    // trisected crease as the surface scheme would; the crease points
-    // themselves stay where trisection put them (linear, on the segment).
-    let pos = sqrt3_positions_trisecting(
-        mesh.points(),
-        &tris,
-        opts.boundary,
-        creases,
-        &corners,
-        &st.trisected,
-    )
-    .positions;
     // Points that never move here: on a feature edge, corners, required
-    // vertices, and every point of an interface (interfaces are refined
-    // linearly so that each region stays exactly what it was).
+    // vertices, and every point of a linear interface (so that each region
+    // stays exactly what it was).
     let mut pinned: HashSet<u32> = corners.clone();
     for e in creases.iter().chain(mesh.feature_edges().keys()) {
         pinned.insert(e[0]);
         pinned.insert(e[1]);
     }
-    for (f, m) in &st.split_interfaces {
-        pinned.extend(f.iter().copied());
-        pinned.insert(*m);
+    if sqrt3_interfaces {
+        // Marked faces inside one region stay linear; a point on both the
+        // boundary and an interface (a junction even where no feature is
+        // tagged, `--features none`) would get two targets.
+        let smooth: HashSet<u32> = st.region_interfaces.iter().map(|(_, m)| *m).collect();
+        for (f, m) in &st.split_interfaces {
+            if !smooth.contains(m) {
+                pinned.extend(f.iter().copied());
+                pinned.insert(*m);
+            }
+        }
+        let on_boundary: HashSet<u32> = st.split_faces.iter().flat_map(|(f, _)| *f).collect();
+        for (f, _) in &st.region_interfaces {
+            pinned.extend(f.iter().filter(|v| on_boundary.contains(v)));
+        }
+    } else {
+        for (f, m) in &st.split_interfaces {
+            pinned.extend(f.iter().copied());
+            pinned.insert(*m);
+        }
     }
-    // Targets: old boundary vertices, then face points.
-    let mut targets: Vec<(u32, DVec3)> = Vec::new();
-    let mut old: Vec<u32> = tris.iter().flatten().copied().collect();
-    old.sort_unstable();
-    old.dedup();
-    for v in old {
-        targets.push((v, pos.vertices[v as usize]));
-    }
-    for (i, &(_, m)) in st.split_faces.iter().enumerate() {
-        targets.push((m, pos.faces[i]));
+    let mut targets = stencil_targets(mesh, &st.split_faces, st, opts, &corners);
+    if sqrt3_interfaces {
+        targets.extend(stencil_targets(
+            mesh,
+            &st.region_interfaces,
+            st,
+            opts,
+            &corners,
+        ));
     }
     let mut ball = Vec::new();
     for (v, target) in targets {
@@ -611,4 +647,43 @@ fn boundary_smooth_phase(
             report.skipped_moves += 1;
         }
     }
+}
+
+/// Where the √3 stencil of `opts.boundary` sends the old points of the split
+/// faces `split` (old triangle, its new point) and their new points: old
+/// points first (each once), then the face points.
+fn stencil_targets(
+    mesh: &TetMesh,
+    split: &[([u32; 3], u32)],
+    st: &StepState,
+    opts: &RefineOptions,
+    corners: &HashSet<u32>,
+) -> Vec<(u32, DVec3)> {
+    if split.is_empty() {
+        return Vec::new();
+    }
+    let tris: Vec<[u32; 3]> = split.iter().map(|(f, _)| *f).collect();
+    // The trisected variant places the face points of faces along a
+    // trisected crease as the surface scheme would; the crease points
+    // themselves stay where trisection put them (linear, on the segment).
+    let pos = sqrt3_positions_trisecting(
+        mesh.points(),
+        &tris,
+        opts.boundary,
+        &st.creases,
+        corners,
+        &st.trisected,
+    )
+    .positions;
+    let mut old: Vec<u32> = tris.iter().flatten().copied().collect();
+    old.sort_unstable();
+    old.dedup();
+    let mut targets: Vec<(u32, DVec3)> = old
+        .into_iter()
+        .map(|v| (v, pos.vertices[v as usize]))
+        .collect();
+    for (i, &(_, m)) in split.iter().enumerate() {
+        targets.push((m, pos.faces[i]));
+    }
+    targets
 }

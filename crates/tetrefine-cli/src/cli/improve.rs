@@ -45,7 +45,12 @@ pub fn run(a: Args) -> super::CliResult {
     let budget = super::guard::MemoryBudget::new(a.max_memory.as_deref())?;
     let mut mesh = super::load(&a.input)?;
     budget.check_improve(mesh.n_tets() as u64)?;
-    super::apply_feature_option(&mut mesh, &a.features, a.feature_angle)?;
+    super::apply_feature_option(
+        &mut mesh,
+        &a.features,
+        a.feature_angle,
+        tetrefine::InterfaceRule::Linear,
+    )?;
     let before = MeshStats::compute(&mesh);
     let report = improve(
         &mut mesh,

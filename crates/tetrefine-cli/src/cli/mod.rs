@@ -190,18 +190,23 @@ pub fn write_mesh_with(
     }
 }
 
-/// Applies `--features auto|none|FILE` to a freshly loaded mesh and tells the
-/// user on stderr what it found.
-pub fn apply_feature_option(mesh: &mut TetMesh, spec: &str, angle_deg: f64) -> CliResult {
-    use tetrefine::detect_features;
+/// Applies `--features auto|none|FILE` to a freshly loaded mesh (for the
+/// refinement's interface rule) and tells the user on stderr what it found.
+pub fn apply_feature_option(
+    mesh: &mut TetMesh,
+    spec: &str,
+    angle_deg: f64,
+    interfaces: tetrefine::InterfaceRule,
+) -> CliResult {
+    use tetrefine::detect_features_for;
     use tetrefine::io::read_edge_list;
     match spec {
         "none" => mesh.clear_features(),
         "auto" => {
-            let r = detect_features(mesh, angle_deg);
+            let r = detect_features_for(mesh, angle_deg, interfaces);
             eprintln!(
-                "features: {} edges ({} by angle > {angle_deg}°, {} between patches, {} at junctions, the rest from the input), {} corners",
-                r.feature_edges, r.by_angle, r.by_patch, r.by_junction, r.corners
+                "features: {} edges ({} by angle > {angle_deg}°, {} between patches, {} at junctions, {} where an interface bends, the rest from the input), {} corners",
+                r.feature_edges, r.by_angle, r.by_patch, r.by_junction, r.curved_interface, r.corners
             );
         }
         file => {

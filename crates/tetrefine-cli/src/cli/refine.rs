@@ -8,7 +8,7 @@ use std::time::Instant;
 use tetrefine::io::read_indicator;
 use tetrefine::report::{step_row, step_table_header};
 use tetrefine::MeshStats;
-use tetrefine::{locate_parents, Phase, RefineOptions, Sqrt3Rule};
+use tetrefine::{locate_parents, InterfaceRule, Phase, RefineOptions, Sqrt3Rule};
 use tetrefine::{select, MarkStrategy};
 
 /// The `--stats` file: `{"steps": [input, step 1, …]}`.
@@ -50,6 +50,12 @@ pub struct Args {
     /// Boundary rule: interpolating (Labsik–Greiner), approximating (Kobbelt) or linear.
     #[arg(long, default_value = "interpolating")]
     pub boundary: Sqrt3Rule,
+    /// Material interfaces: linear (split flat, never smoothed: every region
+    /// keeps its exact volume; a curved interface stays faceted) or sqrt3
+    /// (split, flipped and smoothed on both sides by the --boundary stencil,
+    /// creases only where the interface bends by more than --feature-angle).
+    #[arg(long, default_value = "linear")]
+    pub interfaces: InterfaceRule,
     /// Passes of the optimize phase (edge removal + smoothing); 0 skips it.
     #[arg(long, default_value_t = 3)]
     pub opt_passes: usize,
@@ -340,7 +346,7 @@ pub fn run(a: Args) -> super::CliResult {
         selected,
         input.n_tets() as u64,
     )?;
-    super::apply_feature_option(&mut input, &a.features, a.feature_angle)?;
+    super::apply_feature_option(&mut input, &a.features, a.feature_angle, a.interfaces)?;
     let size = super::size::size_map(
         a.size.as_deref(),
         a.size_array.as_deref(),
@@ -361,6 +367,7 @@ pub fn run(a: Args) -> super::CliResult {
         check_each_phase: false,
         effort: a.effort,
         hausd: a.hausd,
+        interfaces: a.interfaces,
     };
     let t0 = Instant::now();
     let first = MeshStats::compute(&mesh);
