@@ -38,20 +38,6 @@ fn edges(m: &TetMesh) -> Vec<([f64; 3], [f64; 3])> {
         .collect()
 }
 
-fn write_sol(path: &Path, ty: u8, rows: &[Vec<f64>]) {
-    let mut s = format!(
-        "MeshVersionFormatted 2\n\nDimension 3\n\nSolAtVertices\n{}\n1 {ty}\n",
-        rows.len()
-    );
-    for r in rows {
-        let line: Vec<String> = r.iter().map(|x| format!("{x:?}")).collect();
-        s += &line.join(" ");
-        s += "\n";
-    }
-    s += "\nEnd\n";
-    std::fs::write(path, s).unwrap();
-}
-
 fn norm(d: [f64; 3]) -> f64 {
     (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt()
 }
@@ -129,7 +115,7 @@ fn a_scalar_size_map_is_met_with_about_the_predicted_count_and_no_quality_loss()
         .map(|p| vec![h(p.to_array())])
         .collect();
     let sol = inputs.path().join("size.sol");
-    write_sol(&sol, 1, &rows);
+    crate::write_sol(&sol, "SolAtVertices", &[1], &rows);
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("o.mesh");
     refine_ok(&mesh_path, &out, &["--size", sol.to_str().unwrap()]);
@@ -172,7 +158,7 @@ fn an_anisotropic_metric_refines_one_direction_only() {
     let m = vec![1.0 / (hx * hx), 0.0, 1e-6, 0.0, 0.0, 1e-6];
     let rows: Vec<Vec<f64>> = input.points().iter().map(|_| m.clone()).collect();
     let sol = inputs.path().join("metric.sol");
-    write_sol(&sol, 3, &rows);
+    crate::write_sol(&sol, "SolAtVertices", &[3], &rows);
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("o.mesh");
     let iso = dir.path().join("iso.mesh");
@@ -320,7 +306,7 @@ fn bad_size_maps_name_the_file_and_line_and_nothing_is_written() {
     let dir = tempfile::tempdir().unwrap();
     for (name, ty, rows, line, what) in cases {
         let p = inputs.path().join(name);
-        write_sol(&p, ty, &rows);
+        crate::write_sol(&p, "SolAtVertices", &[ty], &rows);
         let o = tetrefine(&[
             "refine",
             &mesh_path,
@@ -360,7 +346,7 @@ fn indicator_sol_is_read_as_an_indicator_with_a_note_and_size_sol_as_sizes() {
     let (input, mesh) = block(dir.path());
     let rows: Vec<Vec<f64>> = mesh.points().iter().map(|p| vec![p.x + 0.5]).collect();
     let sol = dir.path().join("s.sol");
-    write_sol(&sol, 1, &rows);
+    crate::write_sol(&sol, "SolAtVertices", &[1], &rows);
     let out = dir.path().join("o.mesh");
     let o = ok(&[
         "refine",

@@ -25,26 +25,6 @@ fn tripod_points() -> Vec<[f64; 3]> {
     m.points().iter().map(|p| p.to_array()).collect()
 }
 
-/// A Medit ASCII solution, written by hand: `kw` with `rows` of values.
-fn write_sol(path: &Path, kw: &str, types: &[u8], rows: &[Vec<f64>]) {
-    let mut s = format!(
-        "MeshVersionFormatted 2\n\nDimension 3\n\n{kw}\n{}\n{}",
-        rows.len(),
-        types.len()
-    );
-    for t in types {
-        s += &format!(" {t}");
-    }
-    s += "\n";
-    for r in rows {
-        let line: Vec<String> = r.iter().map(|x| format!("{x:?}")).collect();
-        s += &line.join(" ");
-        s += "\n";
-    }
-    s += "\nEnd\n";
-    std::fs::write(path, s).unwrap();
-}
-
 /// `f.sol`: the scalar `f` and the vector `v` at the tripod's points;
 /// `cells.sol`: 1.5 × the tet number at its tets.
 fn fields(dir: &Path) -> (String, String) {
@@ -58,10 +38,10 @@ fn fields(dir: &Path) -> (String, String) {
         })
         .collect();
     let fp = dir.join("f.sol");
-    write_sol(&fp, "SolAtVertices", &[1, 2], &rows);
+    crate::write_sol(&fp, "SolAtVertices", &[1, 2], &rows);
     let cp = dir.join("cells.sol");
     let rows: Vec<Vec<f64>> = (0..2799).map(|t| vec![1.5 * t as f64]).collect();
-    write_sol(&cp, "SolAtTetrahedra", &[1], &rows);
+    crate::write_sol(&cp, "SolAtTetrahedra", &[1], &rows);
     (
         fp.to_str().unwrap().to_string(),
         cp.to_str().unwrap().to_string(),
@@ -283,11 +263,11 @@ fn a_bad_field_names_its_file_and_line_and_nothing_is_written() {
     let pts = tripod_points();
     let short = inputs.path().join("short.sol");
     let rows: Vec<Vec<f64>> = pts.iter().skip(1).map(|&p| vec![f(p)]).collect();
-    write_sol(&short, "SolAtVertices", &[1], &rows);
+    crate::write_sol(&short, "SolAtVertices", &[1], &rows);
     let nan = inputs.path().join("nan.sol");
     let mut rows: Vec<Vec<f64>> = pts.iter().map(|&p| vec![f(p)]).collect();
     rows[10][0] = f64::NAN;
-    write_sol(&nan, "SolAtVertices", &[1], &rows);
+    crate::write_sol(&nan, "SolAtVertices", &[1], &rows);
     let dir = tempfile::tempdir().unwrap();
     for (bad, line, what) in [
         (&short, 6, "entries but the mesh has"),
