@@ -5,6 +5,7 @@ mod support;
 
 mod shapes;
 
+mod formats;
 mod io;
 mod polymesh;
 mod schemes;
