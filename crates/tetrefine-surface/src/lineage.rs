@@ -7,8 +7,9 @@
 //!
 //! * **generation**: the step that made the face (0 for an input face). A
 //!   face that merely continues a face of the previous mesh keeps the
-//!   generation of that face: the shrunk face of vertex truncation, the
-//!   F-face of Doo–Sabin and a triangle that adaptive √3 left unsplit;
+//!   generation and the group of that face: the shrunk face of vertex
+//!   truncation, the F-face of Doo–Sabin and a triangle that adaptive √3
+//!   left unsplit;
 //! * **origin**: the index of the input face it descends from (faces made
 //!   around a vertex or an edge descend from one face at that vertex or
 //!   edge, named in the table below);
@@ -19,10 +20,10 @@
 //! | Loop | the child: 0, 1, 2 at the parent's corners 0, 1, 2; 3 the central triangle | — |
 //! | Catmull–Clark | the child: the parent's corner `k` it holds | — |
 //! | √3 | the child: the parent's half-edge `i` (0, 1, 2) it stands on; unsplit triangles keep theirs | — |
-//! | Doo–Sabin | 0 F-face, 1 E-face, 2 V-face | the face of the edge's first half-edge; the face of the vertex's first outgoing half-edge |
+//! | Doo–Sabin | what the face was made as: 0 input face, 1 E-face, 2 V-face (F-faces continue their face) | the face of the edge's first half-edge; the face of the vertex's first outgoing half-edge |
 //! | weighted Catmull–Clark | the face group of the weights file plus one, 0 for faces in none | — |
 //! | Sierpinski | 0 corner triangle, 1 back face, 2 tube (joint) | back face: the face of the apex's first outgoing half-edge; tube: the face of the edge whose midpoint made the joint |
-//! | truncation | 0 the shrunk face, 1 the face cut off a vertex | the face of the vertex's first outgoing half-edge |
+//! | truncation | what the face was made as: 0 input face, 1 the face cut off a vertex (shrunk faces continue their face) | the face of the vertex's first outgoing half-edge |
 //!
 //! For Loop, Catmull–Clark and √3 the group is the index of the map of the
 //! scheme's iterated function system that made the face (the child of its

@@ -64,6 +64,7 @@
 
 use super::closed_manifold::closed_half_edges;
 use super::error::SurfaceError;
+use super::lineage::{observe, FaceAttributes, StepObserver, Subdivided};
 use super::polymesh::{HalfEdges, PolyMesh, NO_TWIN};
 
 /// Options of [`sierpinski_with`].
@@ -113,12 +114,23 @@ pub fn sierpinski_with(
     steps: usize,
     options: &SierpinskiOptions,
 ) -> Result<PolyMesh, SurfaceError> {
+    sierpinski_tracked(mesh, steps, options, None).map(|s| s.mesh)
+}
+
+/// [`sierpinski_with`] with the face attributes of [`super::lineage`]
+/// (group 0 corner triangle, 1 back face, 2 tube; a tube has the generation
+/// of the step that made its joint and the origin of the face of the edge
+/// whose midpoint the joint is) and an observer of every generation.
+pub fn sierpinski_tracked(
+    mesh: &PolyMesh,
+    steps: usize,
+    options: &SierpinskiOptions,
+    mut observer: Option<&mut StepObserver<'_>>,
+) -> Result<Subdivided, SurfaceError> {
     options.check()?;
     let neck = options.neck;
     let he = closed_half_edges(mesh)?;
-    if steps == 0 {
-        return Ok(mesh.clone());
-    }
+    let input = FaceAttributes::input(mesh.faces.len());
     // Guard against counts that overflow 32-bit ids: V_k from the module docs.
     let e = he.edges.len() as f64;
     let v = he.vertex_out.iter().filter(|&&h| h != NO_TWIN).count() as f64;
@@ -131,11 +143,51 @@ pub fn sierpinski_with(
             what: "vertices",
         });
     }
-    let mut pieces = pyramids(mesh, &he, &[]);
-    for _ in 1..steps {
-        pieces = pieces.step()?;
+    if !observe(&mut observer, 0, mesh, &input) || steps == 0 {
+        return Ok(Subdivided {
+            mesh: mesh.clone(),
+            attributes: input,
+            steps: 0,
+        });
     }
-    pieces.with_tubes(neck)
+    let none = Pieces {
+        mesh: PolyMesh::default(),
+        joints: Vec::new(),
+        attributes: input,
+        joint_attributes: Vec::new(),
+    };
+    let mut pieces = pyramids(mesh, &he, &none, 1);
+    let mut done = 1;
+    if observer.is_some() {
+        let (m, a) = pieces.with_tubes(neck)?;
+        if !observe(&mut observer, 1, &m, &a) {
+            return Ok(Subdivided {
+                mesh: m,
+                attributes: a,
+                steps: 1,
+            });
+        }
+    }
+    for k in 1..steps {
+        pieces = pieces.step(k as u32 + 1)?;
+        done = k + 1;
+        if observer.is_some() {
+            let (m, a) = pieces.with_tubes(neck)?;
+            if !observe(&mut observer, done, &m, &a) {
+                return Ok(Subdivided {
+                    mesh: m,
+                    attributes: a,
+                    steps: done,
+                });
+            }
+        }
+    }
+    let (mesh, attributes) = pieces.with_tubes(neck)?;
+    Ok(Subdivided {
+        mesh,
+        attributes,
+        steps: done,
+    })
 }
 
 /// Closed pieces that touch at joints: pairs of vertices (one in each piece)
@@ -143,6 +195,10 @@ pub fn sierpinski_with(
 struct Pieces {
     mesh: PolyMesh,
     joints: Vec<[u32; 2]>,
+    /// Attributes of the faces of `mesh`.
+    attributes: FaceAttributes,
+    /// Generation and origin face of each joint (of its tube).
+    joint_attributes: Vec<[u32; 2]>,
 }
 
 const NONE: u32 = u32::MAX;
@@ -157,14 +213,14 @@ fn clockwise(he: &HalfEdges, v: u32) -> Vec<u32> {
 }
 
 impl Pieces {
-    fn step(&self) -> Result<Pieces, SurfaceError> {
+    fn step(&self, generation: u32) -> Result<Pieces, SurfaceError> {
         let he = closed_half_edges(&self.mesh)?;
-        Ok(pyramids(&self.mesh, &he, &self.joints))
+        Ok(pyramids(&self.mesh, &he, self, generation))
     }
 
     /// The manifold: every joint becomes a tube of three quadrilaterals
     /// between two triangular holes cut at `neck` along the joint's edges.
-    fn with_tubes(&self, neck: f64) -> Result<PolyMesh, SurfaceError> {
+    fn with_tubes(&self, neck: f64) -> Result<(PolyMesh, FaceAttributes), SurfaceError> {
         let he = closed_half_edges(&self.mesh)?;
         let p = &self.mesh.points;
         let nv = p.len();
@@ -207,7 +263,8 @@ impl Pieces {
             }
             faces.push(out);
         }
-        for &[a, b] in &self.joints {
+        let mut attributes = self.attributes.clone();
+        for (&[a, b], &[generation, origin]) in self.joints.iter().zip(&self.joint_attributes) {
             // Rings: the face of ring[j + 1] holds cut(ring[j]) -> cut(ring[j + 1]).
             let ta: Vec<u32> = clockwise(&he, a).iter().map(|&h| cut[h as usize]).collect();
             let tb: Vec<u32> = clockwise(&he, b).iter().map(|&h| cut[h as usize]).collect();
@@ -237,17 +294,24 @@ impl Pieces {
                 let k = (offset + d - j) % d;
                 let k1 = (offset + 2 * d - j - 1) % d;
                 faces.push(vec![ta[(j + 1) % d], ta[j], tb[k], tb[k1]]);
+                attributes.generation.push(generation);
+                attributes.origin.push(origin);
+                attributes.group.push(2);
             }
         }
-        Ok(PolyMesh { points, faces })
+        Ok((PolyMesh { points, faces }, attributes))
     }
 }
 
-/// One step: a pyramid per used vertex (apex copy, its own midpoint copies,
-/// corner triangles, back face), a joint per edge, and the old joints moved
-/// to the apex copies.
-fn pyramids(mesh: &PolyMesh, he: &HalfEdges, old_joints: &[[u32; 2]]) -> Pieces {
+/// One step (number `generation`) on `mesh`, the mesh of `old` or the
+/// input (then `old` holds the input's attributes and no joints): a pyramid
+/// per used vertex (apex copy, its own midpoint copies, corner triangles,
+/// back face), a joint per edge, and the old joints moved to the apex
+/// copies.
+fn pyramids(mesh: &PolyMesh, he: &HalfEdges, old: &Pieces, generation: u32) -> Pieces {
     let p = &mesh.points;
+    let old_joints = &old.joints;
+    let mut attributes = FaceAttributes::with_capacity(he.len() + p.len());
     let mut points = Vec::new();
     let mut apex = vec![NONE; p.len()];
     let mut mid = vec![NONE; he.len()];
@@ -272,22 +336,31 @@ fn pyramids(mesh: &PolyMesh, he: &HalfEdges, old_joints: &[[u32; 2]]) -> Pieces 
                 apex[v as usize],
                 mid[ring[(j + 1) % n] as usize],
             ]);
+            let parent = he.face[ring[(j + 1) % n] as usize];
+            attributes.push_child(&old.attributes, parent, generation, 0);
         }
         // Back face: the base of the pyramid, against the triangles.
         faces.push(ring.iter().map(|&h| mid[h as usize]).collect());
+        let first = he.face[he.vertex_out[v as usize] as usize];
+        attributes.push_child(&old.attributes, first, generation, 1);
     }
     let mut joints: Vec<[u32; 2]> = old_joints
         .iter()
         .map(|&[a, b]| [apex[a as usize], apex[b as usize]])
         .collect();
+    let mut joint_attributes = old.joint_attributes.clone();
     for (h, &t) in (0..).zip(&he.twin) {
         if h < t {
             joints.push([mid[h as usize], mid[t as usize]]);
+            let origin = old.attributes.origin[he.face[h as usize] as usize];
+            joint_attributes.push([generation, origin]);
         }
     }
     Pieces {
         mesh: PolyMesh { points, faces },
         joints,
+        attributes,
+        joint_attributes,
     }
 }
 

@@ -7,6 +7,7 @@ mod shapes;
 
 mod formats;
 mod io;
+mod lineage;
 mod polymesh;
 mod schemes;
 mod sqrt3;
