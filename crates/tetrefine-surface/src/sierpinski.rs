@@ -33,8 +33,11 @@
 //! This is the connected sum the self-loop stands for, so the surface has the
 //! genus the paper's construction has. Each joint adds 4 vertices, 9 edges
 //! and 3 faces to the two touching pieces (Euler characteristic −2). Further
-//! steps act on the pieces, never on the tubes (ask for all steps in one call
-//! rather than feeding an output back in).
+//! steps act on the pieces, never on the tubes, so all steps must be asked
+//! for in one call: an input that holds a tube of an earlier run (three
+//! quads in a ring whose rim edges all point at one joint) is refused with
+//! [`SurfaceError::SierpinskiJoint`] rather than subdivided wrongly (fed
+//! back in, the one-step tetrahedron would give genus 39, not 15).
 //!
 //! ## Counts
 //!
@@ -66,6 +69,7 @@ use super::closed_manifold::closed_half_edges;
 use super::error::SurfaceError;
 use super::lineage::{observe, FaceAttributes, StepObserver, Subdivided};
 use super::polymesh::{HalfEdges, PolyMesh, NO_TWIN};
+use glam::{DMat3, DVec3};
 
 /// Options of [`sierpinski_with`].
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -130,6 +134,14 @@ pub fn sierpinski_tracked(
     options.check()?;
     let neck = options.neck;
     let he = closed_half_edges(mesh)?;
+    if steps > 0 {
+        if let Some((faces, point)) = find_joint(mesh, &he) {
+            return Err(SurfaceError::SierpinskiJoint {
+                faces,
+                point: point.to_array(),
+            });
+        }
+    }
     let input = FaceAttributes::input(mesh.faces.len());
     // Guard against counts that overflow 32-bit ids: V_k from the module docs.
     let e = he.edges.len() as f64;
@@ -188,6 +200,106 @@ pub fn sierpinski_tracked(
         attributes,
         steps: done,
     })
+}
+
+/// The first joint tube of an earlier run in a closed mesh (its three quads
+/// and the joint's position), if there is one.
+///
+/// A tube ([`Pieces::with_tubes`]) is three quads in a ring: in each, two
+/// opposite sides are shared with the other two quads and the other two
+/// sides lie on the two triangular rims, so the ring has six vertices. Each
+/// rim vertex was cut at `neck` along a piece edge leaving the joint, so it
+/// has exactly one neighbour outside the tube (on the same piece edge), and
+/// the six lines from those neighbours through the rim vertices all meet at
+/// the joint, beyond the rims.
+/// The topology alone also fits an ordinary ring of three quads (a torus
+/// three quads round); the concurrent lines are what make a joint.
+fn find_joint(mesh: &PolyMesh, he: &HalfEdges) -> Option<([usize; 3], DVec3)> {
+    let p = &mesh.points;
+    let quad = |f: u32| mesh.faces[f as usize].len() == 4;
+    for f in 0..mesh.faces.len() as u32 {
+        if !quad(f) {
+            continue;
+        }
+        let s = he.face_start[f as usize];
+        for off in 0..2 {
+            // Tube edges: sides off and off + 2 of f, and the side of g1
+            // opposite its side shared with f.
+            let (h1, h2) = (s + off, s + off + 2);
+            let (t1, t2) = (he.twin[h1 as usize], he.twin[h2 as usize]);
+            if t1 == NO_TWIN || t2 == NO_TWIN {
+                continue;
+            }
+            let (g1, g2) = (he.face[t1 as usize], he.face[t2 as usize]);
+            if g1 == g2 || g1 == f || g2 == f || !quad(g1) || !quad(g2) {
+                continue;
+            }
+            let o1 = he.next(he.next(t1));
+            let o2 = he.next(he.next(t2));
+            if he.twin[o1 as usize] != o2 {
+                continue;
+            }
+            let mut ring: Vec<u32> = [h1, h2, o1]
+                .iter()
+                .flat_map(|&h| [he.origin[h as usize], he.dest(h)])
+                .collect();
+            ring.sort_unstable();
+            ring.dedup();
+            if ring.len() != 6 {
+                continue;
+            }
+            // One line per rim vertex, from its one neighbour outside.
+            let mut lines = Vec::with_capacity(6);
+            for &r in &ring {
+                let (nbrs, _) = he.ring(r);
+                let mut outside = nbrs.iter().filter(|v| !ring.contains(v));
+                match (outside.next(), outside.next()) {
+                    (Some(&u), None) => lines.push((p[u as usize], p[r as usize])),
+                    _ => break,
+                }
+            }
+            if lines.len() != 6 {
+                continue;
+            }
+            if let Some(x) = concurrent(&lines) {
+                return Some(([f as usize, g1 as usize, g2 as usize], x));
+            }
+        }
+    }
+    None
+}
+
+/// The point where the lines `u -> r` meet beyond every `r`, or `None`
+/// when they do not (up to rounding).
+fn concurrent(lines: &[(DVec3, DVec3)]) -> Option<DVec3> {
+    // Least squares: Σ (I − d dᵀ) x = Σ (I − d dᵀ) r.
+    let mut m = DMat3::ZERO;
+    let mut b = DVec3::ZERO;
+    let mut scale: f64 = 0.0;
+    for &(u, r) in lines {
+        let d = (r - u).normalize_or_zero();
+        if d == DVec3::ZERO {
+            return None;
+        }
+        scale = scale.max(u.distance(r));
+        let proj = DMat3::IDENTITY - DMat3::from_cols(d * d.x, d * d.y, d * d.z);
+        m += proj;
+        b += proj * r;
+    }
+    if m.determinant().abs() < 1e-12 {
+        return None;
+    }
+    let x = m.inverse() * b;
+    let tol = 1e-9 * scale;
+    lines
+        .iter()
+        .all(|&(u, r)| {
+            let d = (r - u).normalize();
+            let off = (x - r) - d * (x - r).dot(d);
+            let along = (x - r).dot(d);
+            off.length() <= tol && along > 0.0
+        })
+        .then_some(x)
 }
 
 /// Closed pieces that touch at joints: pairs of vertices (one in each piece)
@@ -574,6 +686,55 @@ mod tests {
             let out = sierpinski_with(&cube(1.0), 2, &SierpinskiOptions { neck }).expect("ok");
             let t = closed_manifold_topology(&out).expect("manifold");
             assert_eq!((t.components, 1 - t.euler / 2), (1, 29));
+        }
+    }
+
+    #[test]
+    fn an_output_fed_back_in_is_refused_naming_a_tube() {
+        for (name, mesh) in [("tetrahedron", tetrahedron()), ("cube", cube(1.0))] {
+            for neck in [1e-4, 0.05, 0.45] {
+                let out = sierpinski_with(&mesh, 1, &SierpinskiOptions { neck }).expect("ok");
+                let err = sierpinski(&out, 1)
+                    .err()
+                    .unwrap_or_else(|| panic!("{name}, neck {neck}: accepted"));
+                let SurfaceError::SierpinskiJoint { faces, point } = &err else {
+                    panic!("{name}, neck {neck}: {err}");
+                };
+                // Joints are at edge midpoints of the input; the faces named
+                // are quads among the tube faces, which follow the pieces'
+                // faces (S + P of them: corner triangles and back faces).
+                let point = DVec3::from_array(*point);
+                let at_midpoint = mesh.edge_list().iter().any(|&[a, b]| {
+                    let m = 0.5 * (mesh.points[a as usize] + mesh.points[b as usize]);
+                    m.distance(point) < 1e-9
+                });
+                assert!(at_midpoint, "{name}, neck {neck}: {point}");
+                let t = closed_manifold_topology(&mesh).expect("closed");
+                let pieces_faces = 2 * t.edges + t.vertices;
+                for &f in faces {
+                    assert_eq!(out.faces[f].len(), 4, "{name}");
+                    assert!(f >= pieces_faces, "{name}: face {f}");
+                }
+                assert!(err.to_string().contains("earlier Sierpinski run"));
+                // Zero steps still return the input unchanged.
+                assert_eq!(sierpinski(&out, 0).expect("ok"), out);
+                // A two-step output too.
+                let two = sierpinski_with(&mesh, 2, &SierpinskiOptions { neck }).expect("ok");
+                assert!(matches!(
+                    sierpinski(&two, 1),
+                    Err(SurfaceError::SierpinskiJoint { .. })
+                ));
+            }
+        }
+    }
+
+    #[test]
+    fn rings_of_three_quads_that_are_not_joints_are_accepted() {
+        // A torus three quads round has rings of three quads with
+        // triangular rims, but the edges through the rims are parallel.
+        for (m, n) in [(4, 3), (3, 3), (5, 3)] {
+            let t = torus(m, n);
+            assert!(sierpinski(&t, 1).is_ok(), "torus {m}x{n}");
         }
     }
 
