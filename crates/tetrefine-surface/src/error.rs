@@ -100,7 +100,7 @@ pub enum SurfaceError {
     /// point at one point (the joint). Sierpinski steps act on the pieces,
     /// never on the tubes, so such an input would be subdivided wrongly.
     #[error(
-        "faces {} are the tube of a joint made by an earlier Sierpinski run (its edges meet at ({}, {}, {})); \
+        "faces {} are the tube of a joint made by an earlier Sierpinski run (its edges meet at ({:.6}, {:.6}, {:.6})); \
          Sierpinski cannot subdivide its own joints: run all the steps in one call on the original surface",
         faces.map(|f| f.to_string()).join(", "), point[0], point[1], point[2]
     )]
