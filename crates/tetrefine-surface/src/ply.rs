@@ -292,6 +292,10 @@ pub fn read(path: &Path) -> Result<SurfaceFile, IoError> {
         little: format == Format::Binary { little: true },
     };
     for el in &elements {
+        if el.props.is_empty() && format != Format::Ascii {
+            // No bytes per entry: nothing to read, however large the count.
+            continue;
+        }
         let is_face = el.name == "face";
         let list_at = if is_face {
             let p = el.props.iter().position(

@@ -213,7 +213,7 @@ fn check_options(a: &Args, features: &Features) -> Result<(), String> {
             return Err("ifs needs an input file with the control points (optional only for --kind koch and gasket)".into());
         }
     } else if a.input.is_none() {
-        return Err("give the input surface (.obj, .off or .ply)".into());
+        return Err("give the input surface (.obj, .off, .ply or .stl)".into());
     }
     Ok(())
 }

@@ -312,6 +312,13 @@ fn big_endian_and_truncated_binary_ply() {
     let m = read_surface(&path).unwrap().mesh;
     assert_eq!(m.points[2], DVec3::new(0.0, 2.5, 0.0));
     assert_eq!(m.faces, vec![vec![0, 1, 2]]);
+    // An element without properties holds no bytes, whatever its count.
+    let empty = header.replace(
+        "element vertex 3",
+        "element nothing 1000000000000\nelement vertex 3",
+    );
+    write_bytes(&path, &empty, &body);
+    assert_eq!(read_surface(&path).unwrap().mesh, m);
     // Cut inside the face: the file and how far it got are named.
     write_bytes(&path, header, &body[..body.len() - 2]);
     let e = read_surface(&path).unwrap_err().to_string();
