@@ -889,6 +889,30 @@ fn sierpinski_refuses_its_own_output_naming_the_file() {
     assert!(ok, "{err}");
     let t = ClosedTopology::of(&load_surface(&twice).unwrap());
     assert_eq!(1 - t.euler() / 2, 15);
+    // --every-step: a generation refused (step 2's tubes round onto their
+    // joints at --neck 1e-17) leaves none of the files, not even those of
+    // steps 0 and 1, and no temporary file.
+    let sub = dir.path().join("sub");
+    std::fs::create_dir(&sub).unwrap();
+    let every = sub.join("s.obj");
+    let (ok, err) = run(&[
+        "surface",
+        "sierpinski",
+        s(&input),
+        "-o",
+        s(&every),
+        "--steps",
+        "2",
+        "--every-step",
+        "--neck",
+        "1e-17",
+    ]);
+    assert!(!ok);
+    assert!(
+        err.contains("step 2: the result has coincident points"),
+        "{err}"
+    );
+    assert_eq!(std::fs::read_dir(&sub).unwrap().count(), 0);
     // --every-step is not for ifs.
     let lines = dir.path().join("koch.csv");
     fails_cleanly(
