@@ -1,7 +1,7 @@
 //! VTK XML PolyData `.vtp` (ASCII data arrays), the surface format ParaView
 //! opens directly. Points are `Float64`; cells are written as VTK's
 //! `connectivity` and `offsets` arrays (`Int64`). [`write()`] writes a polygon
-//! mesh (`Polys`) with the PolyData pieces of [`tetrefine::polyline`], which
+//! mesh (`Polys`) with the PolyData pieces of [`tetrefine::io::vtp`], which
 //! also writes the points and polylines of [`super::ifs`] (`Verts`, `Lines`).
 //! [`write_with`] adds the per-face attributes of [`super::lineage`] as
 //! `UInt32` `CellData` arrays named `generation`, `origin` and `group`.
