@@ -858,37 +858,44 @@ fn every_step_writes_each_generation_with_its_attributes() {
 }
 
 #[test]
-fn sierpinski_refuses_its_own_output_naming_the_file() {
+fn sierpinski_output_fed_back_goes_on_as_one_run() {
     let dir = tempfile::tempdir().unwrap();
     let input = dir.path().join("tet.obj");
     write_surface(&input, &tetrahedron()).unwrap();
+    let sierpinski = |from: &Path, to: &Path, steps: &str| {
+        let (ok, err) = run(&[
+            "surface",
+            "sierpinski",
+            s(from),
+            "-o",
+            s(to),
+            "--steps",
+            steps,
+        ]);
+        assert!(ok, "{err}");
+        ClosedTopology::of(&load_surface(to).unwrap())
+    };
+    // One step, fed back for one more (through .obj and through binary
+    // .ply), is the two-step surface: V = 4, E = 6 give genus
+    // 1 − V + E(4² + 2)/6 = 15 and S = 48, P = 16, J = 30.
     let once = dir.path().join("once.obj");
-    let (ok, err) = run(&["surface", "sierpinski", s(&input), "-o", s(&once)]);
-    assert!(ok, "{err}");
-    let twice = dir.path().join("twice.obj");
-    fails_cleanly(
-        &["surface", "sierpinski", s(&once), "-o", s(&twice)],
-        "earlier Sierpinski run",
-        &twice,
-    );
-    let (_, err) = run(&["surface", "sierpinski", s(&once), "-o", s(&twice)]);
-    assert!(
-        err.contains(&format!("{}: faces ", once.display())),
-        "{err}"
-    );
-    // Asked in one call, two steps give the genus 15 of the formula.
-    let (ok, err) = run(&[
-        "surface",
-        "sierpinski",
-        s(&input),
-        "-o",
-        s(&twice),
-        "--steps",
-        "2",
-    ]);
-    assert!(ok, "{err}");
-    let t = ClosedTopology::of(&load_surface(&twice).unwrap());
-    assert_eq!(1 - t.euler() / 2, 15);
+    sierpinski(&input, &once, "1");
+    let once_ply = dir.path().join("once.ply");
+    sierpinski(&input, &once_ply, "1");
+    let direct = sierpinski(&input, &dir.path().join("direct.obj"), "2");
+    for fed in [&once, &once_ply] {
+        let t = sierpinski(fed, &dir.path().join("again.obj"), "1");
+        assert_eq!(t.components, 1);
+        assert_eq!(1 - t.euler() / 2, 15);
+        assert_eq!(
+            (t.vertices, t.edges, t.faces),
+            (48 + 16 + 4 * 30, 2 * 48 + 9 * 30, 48 + 16 + 3 * 30)
+        );
+        assert_eq!(
+            (t.vertices, t.edges, t.faces),
+            (direct.vertices, direct.edges, direct.faces)
+        );
+    }
     // --every-step: a generation refused (step 2's tubes round onto their
     // joints at --neck 1e-17) leaves none of the files, not even those of
     // steps 0 and 1, and no temporary file.
