@@ -20,7 +20,10 @@
 //! old vertices keep their ids, then one edge point per edge (in the order of
 //! [`HalfEdges::edges`]), then one face point per face.
 
-use super::features::{classify, run_steps, sorted_pair, Features, Role, SubdivisionError};
+use super::features::{
+    classify, corner_children, run_steps, sorted_pair, Features, Role, Step, SubdivisionError,
+};
+use super::lineage::{FaceAttributes, StepObserver, Subdivided};
 use super::polymesh::{HalfEdges, PolyMesh};
 use glam::DVec3;
 use rayon::prelude::*;
@@ -32,14 +35,41 @@ pub fn catmull_clark(
     steps: usize,
     features: &Features,
 ) -> Result<PolyMesh, SubdivisionError> {
+    catmull_clark_tracked(mesh, steps, features, None).map(|s| s.mesh)
+}
+
+/// [`catmull_clark`] with the face attributes of [`super::lineage`] (the
+/// quad at corner `k` of a face is in group `k`) and an observer of every
+/// generation.
+pub fn catmull_clark_tracked(
+    mesh: &PolyMesh,
+    steps: usize,
+    features: &Features,
+    observer: Option<&mut StepObserver<'_>>,
+) -> Result<Subdivided, SubdivisionError> {
     let he = mesh.half_edges()?;
     let (creases, corners) = features.resolve(mesh, &he)?;
-    run_steps(mesh, he, creases, steps, |_, cur, he, creases| {
-        let (curve, roles) = classify(he, creases, &corners);
-        let points = catmull_clark_points(cur, he, &curve, &roles);
-        let faces = catmull_clark_faces(cur, he);
-        (PolyMesh { points, faces }, split_creases(cur, he, creases))
-    })
+    let attributes = FaceAttributes::input(mesh.faces.len());
+    run_steps(
+        mesh,
+        he,
+        creases,
+        steps,
+        attributes,
+        observer,
+        |_, cur, he, creases| {
+            let (curve, roles) = classify(he, creases, &corners);
+            let points = catmull_clark_points(cur, he, &curve, &roles);
+            let faces = catmull_clark_faces(cur, he);
+            let (parent, group) = corner_children(cur);
+            Step {
+                mesh: PolyMesh { points, faces },
+                creases: split_creases(cur, he, creases),
+                parent,
+                group,
+            }
+        },
+    )
 }
 
 /// Face points: the averages of the faces' vertices (summed in face order).

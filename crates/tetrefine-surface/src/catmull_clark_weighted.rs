@@ -69,7 +69,10 @@
 use super::catmull_clark::{
     catmull_clark_faces, crease_vertex_point, in_point_order, split_creases,
 };
-use super::features::{classify, run_steps, sorted_pair, Features, Role, SubdivisionError};
+use super::features::{
+    classify, corner_children, run_steps, sorted_pair, Features, Role, Step, SubdivisionError,
+};
+use super::lineage::{FaceAttributes, StepObserver, Subdivided};
 use super::polymesh::{HalfEdges, PolyMesh, NO_TWIN};
 use glam::DVec3;
 use rayon::prelude::*;
@@ -333,6 +336,20 @@ pub fn catmull_clark_weighted(
     cfg: &WeightedConfig,
     features: &Features,
 ) -> Result<PolyMesh, SubdivisionError> {
+    catmull_clark_weighted_tracked(mesh, steps, cfg, features, None).map(|s| s.mesh)
+}
+
+/// [`catmull_clark_weighted`] with the face attributes of
+/// [`super::lineage`] (group: the face group of the configuration plus one,
+/// 0 for faces in none; input faces included) and an observer of every
+/// generation.
+pub fn catmull_clark_weighted_tracked(
+    mesh: &PolyMesh,
+    steps: usize,
+    cfg: &WeightedConfig,
+    features: &Features,
+    observer: Option<&mut StepObserver<'_>>,
+) -> Result<Subdivided, SubdivisionError> {
     let he0 = mesh.half_edges()?;
     let (creases, corners) = features.resolve(mesh, &he0)?;
     // Validate the configuration against the input.
@@ -420,65 +437,84 @@ pub fn catmull_clark_weighted(
         }
     }
     let mut origin = vec![Origin::Input; mesh.points.len()];
-    run_steps(mesh, he0, creases, steps, |it, cur, h, creases| {
-        let base = cfg.iteration_weights(it);
-        let (curve, roles) = classify(h, creases, &corners);
-        let vertex_locked: Vec<bool> = (0..cur.points.len())
-            .map(|v| {
-                vertex_group.get(&(v as u32)).is_some_and(|&g| {
-                    let grp = &cfg.vertex_groups[g];
-                    grp.lock_start <= it && it < grp.lock_start.saturating_add(grp.lock_iterations)
+    let group_id = |g: Option<usize>| g.map_or(0, |g| g as u32 + 1);
+    let mut attributes = FaceAttributes::input(mesh.faces.len());
+    attributes.group = face_group.iter().map(|&g| group_id(g)).collect();
+    run_steps(
+        mesh,
+        he0,
+        creases,
+        steps,
+        attributes,
+        observer,
+        |it, cur, h, creases| {
+            let base = cfg.iteration_weights(it);
+            let (curve, roles) = classify(h, creases, &corners);
+            let vertex_locked: Vec<bool> = (0..cur.points.len())
+                .map(|v| {
+                    vertex_group.get(&(v as u32)).is_some_and(|&g| {
+                        let grp = &cfg.vertex_groups[g];
+                        grp.lock_start <= it
+                            && it < grp.lock_start.saturating_add(grp.lock_iterations)
+                    })
                 })
-            })
-            .collect();
-        let active_locks: HashSet<[u32; 2]> = locked
-            .iter()
-            .filter(|(_, &(start, end))| start <= it && it < end)
-            .map(|(&e, _)| e)
-            .collect();
-        let ctx = StepContext {
-            mesh: cur,
-            he: h,
-            curve: &curve,
-            roles: &roles,
-            origin: &origin,
-            face_group: &face_group,
-            vertex_group: &vertex_group,
-            vertex_locked: &vertex_locked,
-            locked: &active_locks,
-            cfg,
-            spatial: &spatial,
-            mu_pattern: &mu_pattern,
-            base,
-            first: it == 0,
-        };
-        let points = ctx.points();
-        let faces = catmull_clark_faces(cur, h);
-        // Bookkeeping for the next iteration.
-        let nv = cur.points.len();
-        let ne = h.edges.len();
-        let mut next_origin = vec![Origin::Vertex; nv];
-        next_origin.extend(std::iter::repeat_n(Origin::Edge, ne));
-        next_origin.extend(std::iter::repeat_n(Origin::Face, cur.faces.len()));
-        let mut next_group = Vec::with_capacity(faces.len());
-        for (f, face) in cur.faces.iter().enumerate() {
-            next_group.extend(std::iter::repeat_n(face_group[f], face.len()));
-        }
-        let mut next_locked = HashMap::new();
-        for (e, pair) in h.edges.iter().enumerate() {
-            if let Some(&(start, end)) = locked.get(pair) {
-                if it + 1 < end {
-                    let m = (nv + e) as u32;
-                    next_locked.insert(sorted_pair(pair[0], m), (start, end));
-                    next_locked.insert(sorted_pair(m, pair[1]), (start, end));
+                .collect();
+            let active_locks: HashSet<[u32; 2]> = locked
+                .iter()
+                .filter(|(_, &(start, end))| start <= it && it < end)
+                .map(|(&e, _)| e)
+                .collect();
+            let ctx = StepContext {
+                mesh: cur,
+                he: h,
+                curve: &curve,
+                roles: &roles,
+                origin: &origin,
+                face_group: &face_group,
+                vertex_group: &vertex_group,
+                vertex_locked: &vertex_locked,
+                locked: &active_locks,
+                cfg,
+                spatial: &spatial,
+                mu_pattern: &mu_pattern,
+                base,
+                first: it == 0,
+            };
+            let points = ctx.points();
+            let faces = catmull_clark_faces(cur, h);
+            // Bookkeeping for the next iteration.
+            let nv = cur.points.len();
+            let ne = h.edges.len();
+            let mut next_origin = vec![Origin::Vertex; nv];
+            next_origin.extend(std::iter::repeat_n(Origin::Edge, ne));
+            next_origin.extend(std::iter::repeat_n(Origin::Face, cur.faces.len()));
+            let mut next_group = Vec::with_capacity(faces.len());
+            for (f, face) in cur.faces.iter().enumerate() {
+                next_group.extend(std::iter::repeat_n(face_group[f], face.len()));
+            }
+            let mut next_locked = HashMap::new();
+            for (e, pair) in h.edges.iter().enumerate() {
+                if let Some(&(start, end)) = locked.get(pair) {
+                    if it + 1 < end {
+                        let m = (nv + e) as u32;
+                        next_locked.insert(sorted_pair(pair[0], m), (start, end));
+                        next_locked.insert(sorted_pair(m, pair[1]), (start, end));
+                    }
                 }
             }
-        }
-        origin = next_origin;
-        face_group = next_group;
-        locked = next_locked;
-        (PolyMesh { points, faces }, split_creases(cur, h, creases))
-    })
+            origin = next_origin;
+            let (parent, _) = corner_children(cur);
+            let group = next_group.iter().map(|&g| group_id(g)).collect();
+            face_group = next_group;
+            locked = next_locked;
+            Step {
+                mesh: PolyMesh { points, faces },
+                creases: split_creases(cur, h, creases),
+                parent,
+                group,
+            }
+        },
+    )
 }
 
 struct StepContext<'a> {

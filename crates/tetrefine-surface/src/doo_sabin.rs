@@ -23,6 +23,7 @@
 //! ids are the half-edge ids of the corners.
 
 use super::features::SubdivisionError;
+use super::lineage::{observe, FaceAttributes, StepObserver, Subdivided};
 use super::polymesh::{PolyMesh, NO_TWIN};
 use glam::DVec3;
 use rayon::prelude::*;
@@ -41,17 +42,44 @@ pub fn doo_sabin_weight(n: usize, d: usize) -> f64 {
 
 /// `steps` Doo–Sabin steps.
 pub fn doo_sabin(mesh: &PolyMesh, steps: usize) -> Result<PolyMesh, SubdivisionError> {
-    let mut cur = mesh.clone();
-    for _ in 0..steps {
-        cur = doo_sabin_step(&cur)?;
-    }
-    if steps == 0 {
-        mesh.validate()?;
-    }
-    Ok(cur)
+    doo_sabin_tracked(mesh, steps, None).map(|s| s.mesh)
 }
 
-fn doo_sabin_step(mesh: &PolyMesh) -> Result<PolyMesh, SubdivisionError> {
+/// [`doo_sabin`] with the face attributes of [`super::lineage`] (an F-face
+/// continues its face: generation and group kept; an E-face is in group 1,
+/// from the face of the edge's first half-edge; a V-face in group 2, from
+/// the face of the vertex's first outgoing half-edge) and an observer of
+/// every generation.
+pub fn doo_sabin_tracked(
+    mesh: &PolyMesh,
+    steps: usize,
+    mut observer: Option<&mut StepObserver<'_>>,
+) -> Result<Subdivided, SubdivisionError> {
+    mesh.validate()?;
+    let mut cur = mesh.clone();
+    let mut attrs = FaceAttributes::input(mesh.faces.len());
+    let mut done = 0;
+    if observe(&mut observer, 0, &cur, &attrs) {
+        for k in 0..steps {
+            (cur, attrs) = doo_sabin_step(&cur, &attrs, k as u32 + 1)?;
+            done = k + 1;
+            if !observe(&mut observer, done, &cur, &attrs) {
+                break;
+            }
+        }
+    }
+    Ok(Subdivided {
+        mesh: cur,
+        attributes: attrs,
+        steps: done,
+    })
+}
+
+fn doo_sabin_step(
+    mesh: &PolyMesh,
+    attrs: &FaceAttributes,
+    generation: u32,
+) -> Result<(PolyMesh, FaceAttributes), SubdivisionError> {
     let he = mesh.half_edges()?;
     let p = &mesh.points;
     let corner_pts: Vec<Vec<DVec3>> = mesh
@@ -72,9 +100,12 @@ fn doo_sabin_step(mesh: &PolyMesh) -> Result<PolyMesh, SubdivisionError> {
         })
         .collect();
     let points: Vec<DVec3> = corner_pts.into_iter().flatten().collect();
-    let mut faces: Vec<Vec<u32>> = Vec::with_capacity(mesh.faces.len() + he.edges.len() + p.len());
+    let n = mesh.faces.len() + he.edges.len() + p.len();
+    let mut faces: Vec<Vec<u32>> = Vec::with_capacity(n);
+    let mut out = FaceAttributes::with_capacity(n);
     for f in 0..mesh.faces.len() {
         faces.push((he.face_start[f]..he.face_start[f + 1]).collect());
+        out.push_kept(attrs, f as u32);
     }
     for &h in &he.edge_half {
         let t = he.twin[h as usize];
@@ -83,12 +114,15 @@ fn doo_sabin_step(mesh: &PolyMesh) -> Result<PolyMesh, SubdivisionError> {
         }
         // h: u→w in f, t: w→u in g; corner ids are half-edge ids.
         faces.push(vec![he.next(h), h, he.next(t), t]);
+        out.push_child(attrs, he.face[h as usize], generation, 1);
     }
     for v in 0..p.len() as u32 {
         if he.vertex_out[v as usize] == NO_TWIN || he.is_boundary_vertex(v) {
             continue;
         }
         faces.push(he.outgoing(v));
+        let first = he.vertex_out[v as usize];
+        out.push_child(attrs, he.face[first as usize], generation, 2);
     }
-    Ok(PolyMesh { points, faces })
+    Ok((PolyMesh { points, faces }, out))
 }

@@ -95,6 +95,21 @@ pub enum SurfaceError {
         /// What would overflow (vertices, faces, points).
         what: &'static str,
     },
+    /// The input seems to hold a joint made by an earlier Sierpinski run
+    /// (three quads forming a tube whose six rim vertices lie on edges that
+    /// all point at one point), but removing its tubes and closing their
+    /// rims does not give closed pieces, so the steps cannot go on from it.
+    #[error(
+        "faces {} look like the tube of a joint made by an earlier Sierpinski run (its edges meet at ({:.6}, {:.6}, {:.6})), \
+         but undoing the tubes does not give closed pieces: run all the steps in one call on the original surface",
+        faces.map(|f| f.to_string()).join(", "), point[0], point[1], point[2]
+    )]
+    SierpinskiJoint {
+        /// The three quads of the first tube.
+        faces: [usize; 3],
+        /// Where the edges through its rims meet (the joint's position).
+        point: [f64; 3],
+    },
     /// A parameter is out of its range.
     #[error("{0}")]
     Parameter(String),

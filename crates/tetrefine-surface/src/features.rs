@@ -6,6 +6,7 @@
 //! its scheme), a vertex with one or more than two, or a tagged corner, is a
 //! *corner* (it stays put).
 
+use super::lineage::{observe, FaceAttributes, StepObserver, Subdivided};
 use super::polymesh::{HalfEdges, PolyMesh, TopologyError, NO_TWIN};
 use glam::DVec3;
 use std::collections::HashSet;
@@ -203,31 +204,80 @@ pub(crate) fn classify(
     (curve, roles)
 }
 
+/// What one step of a scheme with tagged creases makes: the refined mesh,
+/// its crease set, and for every new face its parent face in the previous
+/// mesh and its group (see [`super::lineage`]).
+pub(crate) struct Step {
+    /// The refined mesh.
+    pub mesh: PolyMesh,
+    /// Its crease set.
+    pub creases: HashSet<[u32; 2]>,
+    /// Parent face of each new face.
+    pub parent: Vec<u32>,
+    /// Group of each new face.
+    pub group: Vec<u32>,
+}
+
 /// Runs `steps` steps of a scheme with tagged creases from `mesh`, whose
 /// adjacency `he` was built when the input was validated: step `k` gets the
 /// current mesh, its adjacency (`he` for the first step, rebuilt for every
-/// later mesh) and its crease set, and returns the refined mesh and the
-/// refined crease set.
+/// later mesh) and its crease set, and returns the refined mesh, the
+/// refined crease set and the lineage of its faces, from which the face
+/// attributes (`attributes` those of the input) follow. `observer` sees
+/// the input and every step's mesh, and may stop the run.
 pub(crate) fn run_steps(
     mesh: &PolyMesh,
     he: HalfEdges,
     mut creases: HashSet<[u32; 2]>,
     steps: usize,
-    mut step: impl FnMut(
-        usize,
-        &PolyMesh,
-        &HalfEdges,
-        &HashSet<[u32; 2]>,
-    ) -> (PolyMesh, HashSet<[u32; 2]>),
-) -> Result<PolyMesh, SubdivisionError> {
+    attributes: FaceAttributes,
+    mut observer: Option<&mut StepObserver<'_>>,
+    mut step: impl FnMut(usize, &PolyMesh, &HalfEdges, &HashSet<[u32; 2]>) -> Step,
+) -> Result<Subdivided, SubdivisionError> {
     let mut cur = mesh.clone();
+    let mut attrs = attributes;
     let mut first = Some(he);
+    if !observe(&mut observer, 0, &cur, &attrs) {
+        return Ok(Subdivided {
+            mesh: cur,
+            attributes: attrs,
+            steps: 0,
+        });
+    }
     for k in 0..steps {
         let he = match first.take() {
             Some(he) => he,
             None => cur.half_edges()?,
         };
-        (cur, creases) = step(k, &cur, &he, &creases);
+        let s = step(k, &cur, &he, &creases);
+        attrs = attrs.children(k as u32 + 1, &s.parent, &s.group);
+        (cur, creases) = (s.mesh, s.creases);
+        if !observe(&mut observer, k + 1, &cur, &attrs) {
+            return Ok(Subdivided {
+                mesh: cur,
+                attributes: attrs,
+                steps: k + 1,
+            });
+        }
     }
-    Ok(cur)
+    Ok(Subdivided {
+        mesh: cur,
+        attributes: attrs,
+        steps,
+    })
+}
+
+/// Parents and groups of a step in which face `f` of `n` vertices becomes
+/// `n` faces in a row, child `k` in group `k` (Catmull–Clark).
+pub(crate) fn corner_children(mesh: &PolyMesh) -> (Vec<u32>, Vec<u32>) {
+    let n: usize = mesh.faces.iter().map(Vec::len).sum();
+    let mut parent = Vec::with_capacity(n);
+    let mut group = Vec::with_capacity(n);
+    for (f, face) in mesh.faces.iter().enumerate() {
+        for k in 0..face.len() as u32 {
+            parent.push(f as u32);
+            group.push(k);
+        }
+    }
+    (parent, group)
 }

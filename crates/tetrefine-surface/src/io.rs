@@ -4,15 +4,22 @@
 //! |-----------|------|-------|--------|
 //! | `.obj`    | yes  | yes   | [`super::obj`] (Wavefront) |
 //! | `.off`    | yes  | yes   | [`super::off`] (Geomview) |
-//! | `.ply`    | yes (ASCII) | yes (ASCII) | [`super::ply`] (Stanford) |
+//! | `.ply`    | yes (ASCII, binary) | yes (binary little-endian by default, or ASCII) | [`super::ply`] (Stanford) |
+//! | `.stl`    | yes (ASCII, binary) | yes (binary by default, or ASCII; triangles only: faces are fanned) | [`super::stl`] |
 //! | `.vtp`    | no   | yes   | [`super::vtp`] (VTK XML PolyData, for ParaView) |
 //! | `.vtk`    | no   | yes   | [`super::vtk_legacy`] (legacy VTK POLYDATA, ASCII) |
+//!
+//! [`write_surface_with`] takes [`WriteOptions`]: the [`Encoding`] of `.stl`
+//! and `.ply` (the other formats have one) and the per-face attributes of
+//! [`super::lineage`], written as face properties (`.ply`) and cell data
+//! (`.vtp`, `.vtk`); `.obj`, `.off` and `.stl` have no place for them.
 //!
 //! Readers return a [`SurfaceFile`]: the mesh plus the line of every face, so
 //! that [`load_surface`], which also validates manifoldness and orientation,
 //! can name the line of the offending face. Every writer goes through
 //! [`tetrefine::io::write_atomic`]: a failed write leaves no partial file.
 
+use super::lineage::FaceAttributes;
 use super::polymesh::PolyMesh;
 use glam::DVec3;
 use std::io::Write;
@@ -35,8 +42,10 @@ pub enum SurfaceFormat {
     Obj,
     /// Geomview `.off`.
     Off,
-    /// Stanford `.ply` (ASCII).
+    /// Stanford `.ply` (ASCII or binary).
     Ply,
+    /// Stereolithography `.stl` (ASCII or binary; triangles).
+    Stl,
     /// VTK XML PolyData `.vtp` (write only).
     Vtp,
     /// Legacy VTK `.vtk` POLYDATA (write only).
@@ -50,16 +59,17 @@ impl SurfaceFormat {
             "obj" => Ok(SurfaceFormat::Obj),
             "off" => Ok(SurfaceFormat::Off),
             "ply" => Ok(SurfaceFormat::Ply),
+            "stl" => Ok(SurfaceFormat::Stl),
             "vtp" => Ok(SurfaceFormat::Vtp),
             "vtk" => Ok(SurfaceFormat::VtkLegacy),
             "" => Err(IoError::file(
                 path,
-                "has no extension; use .obj, .off, .ply, .vtp or .vtk",
+                "has no extension; use .obj, .off, .ply, .stl, .vtp or .vtk",
             )),
             other => Err(IoError::file(
                 path,
                 format!(
-                    "unknown surface mesh extension '.{other}'; use .obj, .off, .ply, .vtp or .vtk"
+                    "unknown surface mesh extension '.{other}'; use .obj, .off, .ply, .stl, .vtp or .vtk"
                 ),
             )),
         }
@@ -72,9 +82,10 @@ pub fn read_surface(path: &Path) -> Result<SurfaceFile, IoError> {
         SurfaceFormat::Obj => super::obj::read(path),
         SurfaceFormat::Off => super::off::read(path),
         SurfaceFormat::Ply => super::ply::read(path),
+        SurfaceFormat::Stl => super::stl::read(path),
         SurfaceFormat::Vtp | SurfaceFormat::VtkLegacy => Err(IoError::file(
             path,
-            "reading .vtp/.vtk surfaces is not supported; use .obj, .off or .ply",
+            "reading .vtp/.vtk surfaces is not supported; use .obj, .off, .ply or .stl",
         )),
     }
 }
@@ -101,15 +112,74 @@ pub fn load_surface(path: &Path) -> Result<PolyMesh, IoError> {
     }
 }
 
-/// Writes a surface mesh in the format given by the extension of `path`.
+/// How `.stl` and `.ply` files are written.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Encoding {
+    /// Binary (little-endian): smaller and exact for `.ply` (doubles);
+    /// `.stl` holds `f32` coordinates.
+    #[default]
+    Binary,
+    /// Text.
+    Ascii,
+}
+
+/// Options of [`write_surface_with`].
+#[derive(Clone, Copy, Debug, Default)]
+pub struct WriteOptions<'a> {
+    /// Binary or ASCII, for `.stl` and `.ply`.
+    pub encoding: Encoding,
+    /// Per-face attributes to write (`.ply`, `.vtp`, `.vtk`), one entry per
+    /// face.
+    pub attributes: Option<&'a FaceAttributes>,
+}
+
+/// Writes a surface mesh in the format given by the extension of `path`,
+/// with the default [`WriteOptions`] (binary `.stl` and `.ply`, no
+/// attributes).
 pub fn write_surface(path: &Path, mesh: &PolyMesh) -> Result<(), IoError> {
-    match SurfaceFormat::of(path)? {
+    write_surface_with(path, mesh, &WriteOptions::default())
+}
+
+/// Writes a surface mesh in the format given by the extension of `path`.
+/// Attributes whose length is not the number of faces are refused.
+pub fn write_surface_with(
+    path: &Path,
+    mesh: &PolyMesh,
+    options: &WriteOptions,
+) -> Result<(), IoError> {
+    let format = SurfaceFormat::of(path)?;
+    let attributes = options.attributes;
+    if let Some(a) = attributes {
+        let n = mesh.faces.len();
+        if a.generation.len() != n || a.origin.len() != n || a.group.len() != n {
+            return Err(IoError::file(
+                path,
+                format!(
+                    "internal: face attributes for {}/{}/{} faces, the mesh has {n}",
+                    a.generation.len(),
+                    a.origin.len(),
+                    a.group.len()
+                ),
+            ));
+        }
+    }
+    let ascii = options.encoding == Encoding::Ascii;
+    match format {
         SurfaceFormat::Obj => super::obj::write(path, mesh),
         SurfaceFormat::Off => super::off::write(path, mesh),
-        SurfaceFormat::Ply => super::ply::write(path, mesh),
-        SurfaceFormat::Vtp => super::vtp::write(path, mesh),
-        SurfaceFormat::VtkLegacy => super::vtk_legacy::write(path, mesh),
+        SurfaceFormat::Ply => super::ply::write_with(path, mesh, ascii, attributes),
+        SurfaceFormat::Stl => super::stl::write(path, mesh, ascii),
+        SurfaceFormat::Vtp => super::vtp::write_with(path, mesh, attributes),
+        SurfaceFormat::VtkLegacy => super::vtk_legacy::write_with(path, mesh, attributes),
     }
+}
+
+/// The names of the per-face attributes in the files, in the order written.
+pub const ATTRIBUTE_NAMES: [&str; 3] = ["generation", "origin", "group"];
+
+/// The attribute vectors in the order of [`ATTRIBUTE_NAMES`].
+pub(crate) fn attribute_columns(a: &FaceAttributes) -> [&[u32]; 3] {
+    [&a.generation, &a.origin, &a.group]
 }
 
 /// The file as UTF-8 text, or an error naming the file (and the first bad

@@ -17,7 +17,8 @@
 //!
 //! Counts per step: V' = V + E, E' = 2E + 3F, F' = 4F.
 
-use super::features::{classify, run_steps, sorted_pair, Features, Role, SubdivisionError};
+use super::features::{classify, run_steps, sorted_pair, Features, Role, Step, SubdivisionError};
+use super::lineage::{FaceAttributes, StepObserver, Subdivided};
 use super::polymesh::{HalfEdges, PolyMesh, NO_TWIN};
 use glam::DVec3;
 use rayon::prelude::*;
@@ -41,6 +42,19 @@ pub fn loop_subdivide(
     steps: usize,
     features: &Features,
 ) -> Result<PolyMesh, SubdivisionError> {
+    loop_subdivide_tracked(mesh, steps, features, None).map(|s| s.mesh)
+}
+
+/// [`loop_subdivide`] with the face attributes of [`super::lineage`] (the
+/// four children of a triangle are its corner triangles at its vertices 0,
+/// 1, 2, groups 0, 1, 2, then the central one, group 3) and an observer of
+/// every generation.
+pub fn loop_subdivide_tracked(
+    mesh: &PolyMesh,
+    steps: usize,
+    features: &Features,
+    observer: Option<&mut StepObserver<'_>>,
+) -> Result<Subdivided, SubdivisionError> {
     if let Err(f) = mesh.triangles() {
         return Err(SubdivisionError::NotTriangles {
             face: f,
@@ -49,9 +63,25 @@ pub fn loop_subdivide(
     }
     let he = mesh.half_edges()?;
     let (creases, corners) = features.resolve(mesh, &he)?;
-    run_steps(mesh, he, creases, steps, |_, cur, he, creases| {
-        loop_step(cur, he, creases, &corners)
-    })
+    let attributes = FaceAttributes::input(mesh.faces.len());
+    run_steps(
+        mesh,
+        he,
+        creases,
+        steps,
+        attributes,
+        observer,
+        |_, cur, he, creases| {
+            let (mesh, creases) = loop_step(cur, he, creases, &corners);
+            let n = cur.faces.len() as u32;
+            Step {
+                mesh,
+                creases,
+                parent: (0..n).flat_map(|f| [f; 4]).collect(),
+                group: (0..n).flat_map(|_| [0, 1, 2, 3]).collect(),
+            }
+        },
+    )
 }
 
 /// One Loop step; returns the refined mesh and its crease set.

@@ -33,8 +33,17 @@
 //! This is the connected sum the self-loop stands for, so the surface has the
 //! genus the paper's construction has. Each joint adds 4 vertices, 9 edges
 //! and 3 faces to the two touching pieces (Euler characteristic −2). Further
-//! steps act on the pieces, never on the tubes (ask for all steps in one call
-//! rather than feeding an output back in).
+//! steps act on the pieces, never on the tubes. An input that holds the
+//! tubes of an earlier run (three quads in a ring whose edges through the
+//! rims meet in one point, the joint) is turned back into its pieces and
+//! joints first (tubes removed, each rim closed into one vertex at the
+//! joint), so that feeding an output back in goes on as if all steps had
+//! been asked for at once (subdividing the tubes as ordinary faces would
+//! give genus 39 instead of 15 for the one-step tetrahedron fed back); when
+//! that does not give closed pieces the input is refused with
+//! [`SurfaceError::SierpinskiJoint`]. Tubes are recognised in the exact
+//! coordinates of `.obj`, `.off` and `.ply` outputs, not in an `.stl`
+//! (there the quads are split into triangles and the points rounded).
 //!
 //! ## Counts
 //!
@@ -64,7 +73,9 @@
 
 use super::closed_manifold::closed_half_edges;
 use super::error::SurfaceError;
+use super::lineage::{observe, FaceAttributes, StepObserver, Subdivided};
 use super::polymesh::{HalfEdges, PolyMesh, NO_TWIN};
+use glam::{DMat3, DVec3};
 
 /// Options of [`sierpinski_with`].
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -113,12 +124,25 @@ pub fn sierpinski_with(
     steps: usize,
     options: &SierpinskiOptions,
 ) -> Result<PolyMesh, SurfaceError> {
+    sierpinski_tracked(mesh, steps, options, None).map(|s| s.mesh)
+}
+
+/// [`sierpinski_with`] with the face attributes of [`super::lineage`]
+/// (group 0 corner triangle, 1 back face, 2 tube; a tube has the generation
+/// of the step that made its joint and the origin of the face of the edge
+/// whose midpoint the joint is; the joints of an earlier run's output fed
+/// in count as generation 0, with the origin of their first tube face) and
+/// an observer of every generation.
+pub fn sierpinski_tracked(
+    mesh: &PolyMesh,
+    steps: usize,
+    options: &SierpinskiOptions,
+    mut observer: Option<&mut StepObserver<'_>>,
+) -> Result<Subdivided, SurfaceError> {
     options.check()?;
     let neck = options.neck;
     let he = closed_half_edges(mesh)?;
-    if steps == 0 {
-        return Ok(mesh.clone());
-    }
+    let input = FaceAttributes::input(mesh.faces.len());
     // Guard against counts that overflow 32-bit ids: V_k from the module docs.
     let e = he.edges.len() as f64;
     let v = he.vertex_out.iter().filter(|&&h| h != NO_TWIN).count() as f64;
@@ -131,11 +155,274 @@ pub fn sierpinski_with(
             what: "vertices",
         });
     }
-    let mut pieces = pyramids(mesh, &he, &[]);
-    for _ in 1..steps {
-        pieces = pieces.step()?;
+    if !observe(&mut observer, 0, mesh, &input) || steps == 0 {
+        return Ok(Subdivided {
+            mesh: mesh.clone(),
+            attributes: input,
+            steps: 0,
+        });
     }
-    pieces.with_tubes(neck)
+    // An earlier run's output: its tubes become joints again, so that the
+    // steps go on from its pieces as if all had been asked for at once.
+    let tubes = find_tubes(mesh, &he);
+    let start = if tubes.is_empty() {
+        // `pyramids` takes the mesh and its adjacency directly below.
+        Pieces {
+            mesh: PolyMesh::default(),
+            joints: Vec::new(),
+            attributes: input,
+            joint_attributes: Vec::new(),
+        }
+    } else {
+        let refuse = || SurfaceError::SierpinskiJoint {
+            faces: tubes[0].faces.map(|f| f as usize),
+            point: tubes[0].point.to_array(),
+        };
+        let pieces = untube(mesh, &tubes).ok_or_else(refuse)?;
+        closed_half_edges(&pieces.mesh).map_err(|_| refuse())?;
+        pieces
+    };
+    let mut pieces = if tubes.is_empty() {
+        pyramids(mesh, &he, &start, 1)
+    } else {
+        start.step(1)?
+    };
+    let mut done = 1;
+    if observer.is_some() {
+        let (m, a) = pieces.with_tubes(neck)?;
+        if !observe(&mut observer, 1, &m, &a) {
+            return Ok(Subdivided {
+                mesh: m,
+                attributes: a,
+                steps: 1,
+            });
+        }
+    }
+    for k in 1..steps {
+        pieces = pieces.step(k as u32 + 1)?;
+        done = k + 1;
+        if observer.is_some() {
+            let (m, a) = pieces.with_tubes(neck)?;
+            if !observe(&mut observer, done, &m, &a) {
+                return Ok(Subdivided {
+                    mesh: m,
+                    attributes: a,
+                    steps: done,
+                });
+            }
+        }
+    }
+    let (mesh, attributes) = pieces.with_tubes(neck)?;
+    Ok(Subdivided {
+        mesh,
+        attributes,
+        steps: done,
+    })
+}
+
+/// A joint tube of an earlier run, found in an input mesh.
+#[derive(Clone, Debug, PartialEq)]
+struct Tube {
+    /// Its three quads.
+    faces: [u32; 3],
+    /// The vertices of its two triangular rims, one rim per piece.
+    rims: [[u32; 3]; 2],
+    /// Where the edges through the rims meet: the joint.
+    point: DVec3,
+}
+
+/// The joint tubes of an earlier run in a closed mesh.
+///
+/// A tube ([`Pieces::with_tubes`]) is three quads in a ring: in each, two
+/// opposite sides are shared with the other two quads and the other two
+/// sides lie on the two triangular rims, so the ring has six vertices. Each
+/// rim vertex was cut at `neck` along a piece edge leaving the joint, so it
+/// has exactly one neighbour outside the tube (on the same piece edge), and
+/// the six lines from those neighbours through the rim vertices all meet at
+/// the joint, beyond the rims.
+/// The topology alone also fits an ordinary ring of three quads (a torus
+/// three quads round); the concurrent lines are what make a joint.
+fn find_tubes(mesh: &PolyMesh, he: &HalfEdges) -> Vec<Tube> {
+    let p = &mesh.points;
+    let quad = |f: u32| mesh.faces[f as usize].len() == 4;
+    let mut in_tube = vec![false; mesh.faces.len()];
+    let mut tubes = Vec::new();
+    for f in 0..mesh.faces.len() as u32 {
+        if !quad(f) || in_tube[f as usize] {
+            continue;
+        }
+        let s = he.face_start[f as usize];
+        for off in 0..2 {
+            // Tube edges: sides off and off + 2 of f, and the side of g1
+            // opposite its side shared with f.
+            let (h1, h2) = (s + off, s + off + 2);
+            let (t1, t2) = (he.twin[h1 as usize], he.twin[h2 as usize]);
+            if t1 == NO_TWIN || t2 == NO_TWIN {
+                continue;
+            }
+            let (g1, g2) = (he.face[t1 as usize], he.face[t2 as usize]);
+            if g1 == g2 || g1 == f || g2 == f || !quad(g1) || !quad(g2) {
+                continue;
+            }
+            let o1 = he.next(he.next(t1));
+            let o2 = he.next(he.next(t2));
+            if he.twin[o1 as usize] != o2 {
+                continue;
+            }
+            let mut ring: Vec<u32> = [h1, h2, o1]
+                .iter()
+                .flat_map(|&h| [he.origin[h as usize], he.dest(h)])
+                .collect();
+            ring.sort_unstable();
+            ring.dedup();
+            if ring.len() != 6 {
+                continue;
+            }
+            // One line per rim vertex, from its one neighbour outside.
+            let mut lines = Vec::with_capacity(6);
+            for &r in &ring {
+                let (nbrs, _) = he.ring(r);
+                let mut outside = nbrs.iter().filter(|v| !ring.contains(v));
+                match (outside.next(), outside.next()) {
+                    (Some(&u), None) => lines.push((p[u as usize], p[r as usize])),
+                    _ => break,
+                }
+            }
+            if lines.len() != 6 {
+                continue;
+            }
+            let Some(point) = concurrent(&lines) else {
+                continue;
+            };
+            // The rims: the sides that are not tube edges (each quad's
+            // sides after its two tube edges) join the vertices of a rim.
+            let mut rim_of = [0usize, 1, 2, 3, 4, 5];
+            let slot = |v: u32| ring.iter().position(|&x| x == v).unwrap_or(0);
+            for h in [h1, h2, t1, o1, t2, o2] {
+                let side = he.next(h);
+                let (a, b) = (slot(he.origin[side as usize]), slot(he.dest(side)));
+                let (ra, rb) = (rim_of[a], rim_of[b]);
+                for r in &mut rim_of {
+                    if *r == rb {
+                        *r = ra;
+                    }
+                }
+            }
+            let first: Vec<u32> = (0..6)
+                .filter(|&k| rim_of[k] == rim_of[0])
+                .map(|k| ring[k])
+                .collect();
+            let second: Vec<u32> = (0..6)
+                .filter(|&k| rim_of[k] != rim_of[0])
+                .map(|k| ring[k])
+                .collect();
+            let (Ok(a), Ok(b)) = (<[u32; 3]>::try_from(first), <[u32; 3]>::try_from(second)) else {
+                continue;
+            };
+            for g in [f, g1, g2] {
+                in_tube[g as usize] = true;
+            }
+            tubes.push(Tube {
+                faces: [f, g1, g2],
+                rims: [a, b],
+                point,
+            });
+            break;
+        }
+    }
+    tubes
+}
+
+/// The pieces and joints an earlier run's output was made from: every tube
+/// removed and each of its rims collapsed back into one joint vertex at the
+/// joint's position; faces, attributes and joints as [`pyramids`] expects
+/// them (the input's faces are generation 0, a joint has generation 0 and
+/// the origin of its first tube face). `None` when that does not give
+/// closed pieces (rims sharing vertices, a face collapsing).
+fn untube(mesh: &PolyMesh, tubes: &[Tube]) -> Option<Pieces> {
+    let nf = mesh.faces.len();
+    let mut points = mesh.points.clone();
+    let mut map: Vec<u32> = (0..points.len() as u32).collect();
+    let mut moved = vec![false; points.len()];
+    let mut is_tube = vec![false; nf];
+    let mut joints = Vec::with_capacity(tubes.len());
+    let mut joint_attributes = Vec::with_capacity(tubes.len());
+    for t in tubes {
+        let mut ends = [0u32; 2];
+        for (end, rim) in ends.iter_mut().zip(&t.rims) {
+            *end = points.len() as u32;
+            points.push(t.point);
+            for &v in rim {
+                if std::mem::replace(&mut moved[v as usize], true) {
+                    return None;
+                }
+                map[v as usize] = *end;
+            }
+        }
+        joints.push(ends);
+        joint_attributes.push([0, t.faces[0]]);
+        for f in t.faces {
+            is_tube[f as usize] = true;
+        }
+    }
+    let mut faces = Vec::with_capacity(nf);
+    let mut attributes = FaceAttributes::with_capacity(nf);
+    for (f, face) in mesh.faces.iter().enumerate() {
+        if is_tube[f] {
+            continue;
+        }
+        let mut out: Vec<u32> = face.iter().map(|&v| map[v as usize]).collect();
+        out.dedup();
+        while out.len() > 1 && out.first() == out.last() {
+            out.pop();
+        }
+        if out.len() < 3 {
+            return None;
+        }
+        faces.push(out);
+        attributes.generation.push(0);
+        attributes.origin.push(f as u32);
+        attributes.group.push(0);
+    }
+    Some(Pieces {
+        mesh: PolyMesh { points, faces },
+        joints,
+        attributes,
+        joint_attributes,
+    })
+}
+
+/// The point where the lines `u -> r` meet beyond every `r`, or `None`
+/// when they do not (up to rounding).
+fn concurrent(lines: &[(DVec3, DVec3)]) -> Option<DVec3> {
+    // Least squares: Σ (I − d dᵀ) x = Σ (I − d dᵀ) r.
+    let mut m = DMat3::ZERO;
+    let mut b = DVec3::ZERO;
+    let mut scale: f64 = 0.0;
+    for &(u, r) in lines {
+        let d = (r - u).normalize_or_zero();
+        if d == DVec3::ZERO {
+            return None;
+        }
+        scale = scale.max(u.distance(r));
+        let proj = DMat3::IDENTITY - DMat3::from_cols(d * d.x, d * d.y, d * d.z);
+        m += proj;
+        b += proj * r;
+    }
+    if m.determinant().abs() < 1e-12 {
+        return None;
+    }
+    let x = m.inverse() * b;
+    let tol = 1e-9 * scale;
+    lines
+        .iter()
+        .all(|&(u, r)| {
+            let d = (r - u).normalize();
+            let off = (x - r) - d * (x - r).dot(d);
+            let along = (x - r).dot(d);
+            off.length() <= tol && along > 0.0
+        })
+        .then_some(x)
 }
 
 /// Closed pieces that touch at joints: pairs of vertices (one in each piece)
@@ -143,6 +430,10 @@ pub fn sierpinski_with(
 struct Pieces {
     mesh: PolyMesh,
     joints: Vec<[u32; 2]>,
+    /// Attributes of the faces of `mesh`.
+    attributes: FaceAttributes,
+    /// Generation and origin face of each joint (of its tube).
+    joint_attributes: Vec<[u32; 2]>,
 }
 
 const NONE: u32 = u32::MAX;
@@ -157,14 +448,14 @@ fn clockwise(he: &HalfEdges, v: u32) -> Vec<u32> {
 }
 
 impl Pieces {
-    fn step(&self) -> Result<Pieces, SurfaceError> {
+    fn step(&self, generation: u32) -> Result<Pieces, SurfaceError> {
         let he = closed_half_edges(&self.mesh)?;
-        Ok(pyramids(&self.mesh, &he, &self.joints))
+        Ok(pyramids(&self.mesh, &he, self, generation))
     }
 
     /// The manifold: every joint becomes a tube of three quadrilaterals
     /// between two triangular holes cut at `neck` along the joint's edges.
-    fn with_tubes(&self, neck: f64) -> Result<PolyMesh, SurfaceError> {
+    fn with_tubes(&self, neck: f64) -> Result<(PolyMesh, FaceAttributes), SurfaceError> {
         let he = closed_half_edges(&self.mesh)?;
         let p = &self.mesh.points;
         let nv = p.len();
@@ -207,7 +498,8 @@ impl Pieces {
             }
             faces.push(out);
         }
-        for &[a, b] in &self.joints {
+        let mut attributes = self.attributes.clone();
+        for (&[a, b], &[generation, origin]) in self.joints.iter().zip(&self.joint_attributes) {
             // Rings: the face of ring[j + 1] holds cut(ring[j]) -> cut(ring[j + 1]).
             let ta: Vec<u32> = clockwise(&he, a).iter().map(|&h| cut[h as usize]).collect();
             let tb: Vec<u32> = clockwise(&he, b).iter().map(|&h| cut[h as usize]).collect();
@@ -237,17 +529,24 @@ impl Pieces {
                 let k = (offset + d - j) % d;
                 let k1 = (offset + 2 * d - j - 1) % d;
                 faces.push(vec![ta[(j + 1) % d], ta[j], tb[k], tb[k1]]);
+                attributes.generation.push(generation);
+                attributes.origin.push(origin);
+                attributes.group.push(2);
             }
         }
-        Ok(PolyMesh { points, faces })
+        Ok((PolyMesh { points, faces }, attributes))
     }
 }
 
-/// One step: a pyramid per used vertex (apex copy, its own midpoint copies,
-/// corner triangles, back face), a joint per edge, and the old joints moved
-/// to the apex copies.
-fn pyramids(mesh: &PolyMesh, he: &HalfEdges, old_joints: &[[u32; 2]]) -> Pieces {
+/// One step (number `generation`) on `mesh`, the mesh of `old` or the
+/// input (then `old` holds the input's attributes and no joints): a pyramid
+/// per used vertex (apex copy, its own midpoint copies, corner triangles,
+/// back face), a joint per edge, and the old joints moved to the apex
+/// copies.
+fn pyramids(mesh: &PolyMesh, he: &HalfEdges, old: &Pieces, generation: u32) -> Pieces {
     let p = &mesh.points;
+    let old_joints = &old.joints;
+    let mut attributes = FaceAttributes::with_capacity(he.len() + p.len());
     let mut points = Vec::new();
     let mut apex = vec![NONE; p.len()];
     let mut mid = vec![NONE; he.len()];
@@ -272,22 +571,31 @@ fn pyramids(mesh: &PolyMesh, he: &HalfEdges, old_joints: &[[u32; 2]]) -> Pieces 
                 apex[v as usize],
                 mid[ring[(j + 1) % n] as usize],
             ]);
+            let parent = he.face[ring[(j + 1) % n] as usize];
+            attributes.push_child(&old.attributes, parent, generation, 0);
         }
         // Back face: the base of the pyramid, against the triangles.
         faces.push(ring.iter().map(|&h| mid[h as usize]).collect());
+        let first = he.face[he.vertex_out[v as usize] as usize];
+        attributes.push_child(&old.attributes, first, generation, 1);
     }
     let mut joints: Vec<[u32; 2]> = old_joints
         .iter()
         .map(|&[a, b]| [apex[a as usize], apex[b as usize]])
         .collect();
+    let mut joint_attributes = old.joint_attributes.clone();
     for (h, &t) in (0..).zip(&he.twin) {
         if h < t {
             joints.push([mid[h as usize], mid[t as usize]]);
+            let origin = old.attributes.origin[he.face[h as usize] as usize];
+            joint_attributes.push([generation, origin]);
         }
     }
     Pieces {
         mesh: PolyMesh { points, faces },
         joints,
+        attributes,
+        joint_attributes,
     }
 }
 
@@ -501,6 +809,80 @@ mod tests {
             let out = sierpinski_with(&cube(1.0), 2, &SierpinskiOptions { neck }).expect("ok");
             let t = closed_manifold_topology(&out).expect("manifold");
             assert_eq!((t.components, 1 - t.euler / 2), (1, 29));
+        }
+    }
+
+    /// The points, quantized to 1e-9 and sorted: equal for two meshes
+    /// whose points agree up to rounding, whatever their order.
+    fn point_set(m: &PolyMesh) -> Vec<[i64; 3]> {
+        let mut v: Vec<[i64; 3]> = m
+            .points
+            .iter()
+            .map(|p| p.to_array().map(|c| (c * 1e9).round() as i64))
+            .collect();
+        v.sort_unstable();
+        v
+    }
+
+    #[test]
+    fn an_output_fed_back_in_goes_on_as_one_run() {
+        for (name, mesh) in [("tetrahedron", tetrahedron()), ("cube", cube(1.0))] {
+            let input = closed_manifold_topology(&mesh).expect("closed");
+            let (v, e) = (input.vertices as i64, input.edges as i64);
+            for neck in [1e-4, 0.05, 0.45] {
+                let opts = SierpinskiOptions { neck };
+                let run = |m: &PolyMesh, k: usize| sierpinski_with(m, k, &opts).expect("ok");
+                let one = run(&mesh, 1);
+                let tubes = find_tubes(&one, &one.half_edges().expect("manifold"));
+                assert_eq!(tubes.len() as i64, e, "{name}: one tube per input edge");
+                for (fed, k, total) in [(&one, 1, 2), (&one, 2, 3), (&run(&mesh, 2), 1, 3)] {
+                    let out = run(fed, k);
+                    let t = closed_manifold_topology(&out)
+                        .unwrap_or_else(|err| panic!("{name}, neck {neck}: {err}"));
+                    let p = predicted(v, e, total);
+                    assert_eq!(
+                        (
+                            t.components,
+                            t.vertices as i64,
+                            t.edges as i64,
+                            t.faces as i64
+                        ),
+                        (1, p.vertices, p.edges, p.faces),
+                        "{name}, neck {neck}: {k} more steps after {}",
+                        total as usize - k
+                    );
+                    assert_eq!(1 - t.euler / 2, p.genus);
+                    // The same points as the run asked for all at once.
+                    assert_eq!(
+                        point_set(&out),
+                        point_set(&run(&mesh, total as usize)),
+                        "{name}"
+                    );
+                }
+                // Zero steps still return the input unchanged.
+                assert_eq!(sierpinski(&one, 0).expect("ok"), one);
+            }
+        }
+    }
+
+    #[test]
+    fn tubes_that_cannot_be_undone_are_refused() {
+        let one = sierpinski(&tetrahedron(), 1).expect("ok");
+        let tubes = find_tubes(&one, &one.half_edges().expect("manifold"));
+        assert_eq!(tubes.len(), 6);
+        assert!(untube(&one, &tubes).is_some());
+        // A rim claimed by two tubes cannot be closed twice.
+        let twice = [tubes[0].clone(), tubes[0].clone()];
+        assert!(untube(&one, &twice).is_none());
+    }
+
+    #[test]
+    fn rings_of_three_quads_that_are_not_joints_are_accepted() {
+        // A torus three quads round has rings of three quads with
+        // triangular rims, but the edges through the rims are parallel.
+        for (m, n) in [(4, 3), (3, 3), (5, 3)] {
+            let t = torus(m, n);
+            assert!(sierpinski(&t, 1).is_ok(), "torus {m}x{n}");
         }
     }
 

@@ -14,6 +14,7 @@ pub use tetrefine::stencil::{
 };
 
 use super::features::{Features, SubdivisionError};
+use super::lineage::{observe, FaceAttributes, StepObserver, Subdivided};
 use super::polymesh::PolyMesh;
 use glam::DVec3;
 use rayon::prelude::*;
@@ -23,6 +24,8 @@ use tetrefine::topo::edge_key;
 
 /// No triangle, no point: a slot the step leaves empty.
 const NONE: u32 = u32::MAX;
+/// The child index of a triangle that a step left unsplit.
+const KEPT: u8 = u8::MAX;
 
 /// Which triangles an adaptive √3 step splits, decided on the triangle's
 /// centroid.
@@ -95,6 +98,34 @@ pub struct Sqrt3Surface {
 impl Sqrt3Surface {
     /// One √3 step with `rule`, splitting the triangles `selection` picks.
     pub fn step(&mut self, rule: Sqrt3Rule, selection: &FaceSelection) {
+        self.step_lineage(rule, selection);
+    }
+
+    /// [`Sqrt3Surface::step`], returning the face attributes of the new
+    /// triangles from `attributes`, those of the current ones (see
+    /// [`super::lineage`]: a split triangle's children are in group `i`, the
+    /// half-edge they stand on; an unsplit triangle keeps its attributes).
+    pub fn step_tracked(
+        &mut self,
+        rule: Sqrt3Rule,
+        selection: &FaceSelection,
+        attributes: &FaceAttributes,
+    ) -> FaceAttributes {
+        let lineage = self.step_lineage(rule, selection);
+        let generation = self.generation as u32;
+        let mut out = FaceAttributes::with_capacity(lineage.len());
+        for (parent, child) in lineage {
+            match child {
+                KEPT => out.push_kept(attributes, parent),
+                i => out.push_child(attributes, parent, generation, i as u32),
+            }
+        }
+        out
+    }
+
+    /// One step; for each new triangle its parent and its child index
+    /// (0, 1, 2), or [`KEPT`] for an unsplit triangle.
+    fn step_lineage(&mut self, rule: Sqrt3Rule, selection: &FaceSelection) -> Vec<(u32, u8)> {
         let np = self.points.len();
         let nt = self.tris.len();
         let topo = TriTopology::build(np, &self.tris, &self.creases, &self.corners);
@@ -235,10 +266,12 @@ impl Sqrt3Surface {
             })
             .collect();
         let mut new_tris = Vec::with_capacity(nt * 3);
-        for r in out {
-            for t in r {
-                if t[0] != NONE {
-                    new_tris.push(t);
+        let mut lineage = Vec::with_capacity(nt * 3);
+        for (t, r) in out.into_iter().enumerate() {
+            for (i, tri) in r.into_iter().enumerate() {
+                if tri[0] != NONE {
+                    new_tris.push(tri);
+                    lineage.push((t as u32, if selected[t] { i as u8 } else { KEPT }));
                 }
             }
         }
@@ -260,6 +293,7 @@ impl Sqrt3Surface {
         self.tris = new_tris;
         self.creases = new_creases;
         self.generation += 1;
+        lineage
     }
 
     /// The surface as a polygon mesh.
@@ -279,6 +313,18 @@ pub fn sqrt3(
     steps: usize,
     options: &Sqrt3Options,
 ) -> Result<PolyMesh, SubdivisionError> {
+    sqrt3_tracked(mesh, rule, steps, options, None).map(|s| s.mesh)
+}
+
+/// [`sqrt3`] with the face attributes of [`super::lineage`] and an observer
+/// of every generation.
+pub fn sqrt3_tracked(
+    mesh: &PolyMesh,
+    rule: Sqrt3Rule,
+    steps: usize,
+    options: &Sqrt3Options,
+    mut observer: Option<&mut StepObserver<'_>>,
+) -> Result<Subdivided, SubdivisionError> {
     let tris = mesh
         .triangles()
         .map_err(|f| SubdivisionError::NotTriangles {
@@ -294,8 +340,23 @@ pub fn sqrt3(
         corners,
         generation: 0,
     };
-    for _ in 0..steps {
-        s.step(rule, &options.selection);
+    let mut attrs = FaceAttributes::input(mesh.faces.len());
+    let mut done = 0;
+    // The observer needs the mesh of every generation; without one only
+    // the last is built.
+    let watching = observer.is_some();
+    if observe(&mut observer, 0, mesh, &attrs) {
+        for k in 0..steps {
+            attrs = s.step_tracked(rule, &options.selection, &attrs);
+            done = k + 1;
+            if watching && !observe(&mut observer, done, &s.to_polymesh(), &attrs) {
+                break;
+            }
+        }
     }
-    Ok(s.to_polymesh())
+    Ok(Subdivided {
+        mesh: s.to_polymesh(),
+        attributes: attrs,
+        steps: done,
+    })
 }

@@ -23,6 +23,7 @@
 
 use super::closed_manifold::closed_half_edges;
 use super::error::SurfaceError;
+use super::lineage::{observe, FaceAttributes, StepObserver, Subdivided};
 use super::polymesh::{HalfEdges, PolyMesh};
 
 /// `steps` steps of Chaikin vertex truncation (cut at 1/4 and 3/4 of every
@@ -48,6 +49,19 @@ pub fn check_cut(cut: f64) -> Result<(), SurfaceError> {
 /// Vertex truncation that cuts every edge at `cut` and `1 − cut` of its length
 /// (`0 < cut < 0.5`; Chaikin's rule, and [`truncate`], is `cut = 0.25`).
 pub fn truncate_with(mesh: &PolyMesh, steps: usize, cut: f64) -> Result<PolyMesh, SurfaceError> {
+    truncate_tracked(mesh, steps, cut, None).map(|s| s.mesh)
+}
+
+/// [`truncate_with`] with the face attributes of [`super::lineage`] (the
+/// shrunk old face continues its face: generation and group kept; the face
+/// cut off a vertex is in group 1, from the face of the vertex's first
+/// outgoing half-edge) and an observer of every generation.
+pub fn truncate_tracked(
+    mesh: &PolyMesh,
+    steps: usize,
+    cut: f64,
+    mut observer: Option<&mut StepObserver<'_>>,
+) -> Result<Subdivided, SurfaceError> {
     check_cut(cut)?;
     let he = closed_half_edges(mesh)?;
     let estimate = he.len() as f64 * 3f64.powi(steps.min(64) as i32);
@@ -58,18 +72,37 @@ pub fn truncate_with(mesh: &PolyMesh, steps: usize, cut: f64) -> Result<PolyMesh
             what: "half-edges",
         });
     }
-    if steps == 0 {
-        return Ok(mesh.clone());
+    let mut current = mesh.clone();
+    let mut attrs = FaceAttributes::input(mesh.faces.len());
+    let mut done = 0;
+    let mut he = Some(he);
+    if observe(&mut observer, 0, &current, &attrs) {
+        for k in 0..steps {
+            let h = match he.take() {
+                Some(h) => h,
+                None => closed_half_edges(&current)?,
+            };
+            (current, attrs) = truncate_once(&current, &h, cut, &attrs, k as u32 + 1);
+            done = k + 1;
+            if !observe(&mut observer, done, &current, &attrs) {
+                break;
+            }
+        }
     }
-    let mut current = truncate_once(mesh, &he, cut);
-    for _ in 1..steps {
-        let he = closed_half_edges(&current)?;
-        current = truncate_once(&current, &he, cut);
-    }
-    Ok(current)
+    Ok(Subdivided {
+        mesh: current,
+        attributes: attrs,
+        steps: done,
+    })
 }
 
-fn truncate_once(mesh: &PolyMesh, he: &HalfEdges, cut: f64) -> PolyMesh {
+fn truncate_once(
+    mesh: &PolyMesh,
+    he: &HalfEdges,
+    cut: f64,
+    attrs: &FaceAttributes,
+    generation: u32,
+) -> (PolyMesh, FaceAttributes) {
     let p = &mesh.points;
     // One new vertex per half-edge v -> w, at v + cut (w - v); its id is the
     // half-edge id.
@@ -80,7 +113,9 @@ fn truncate_once(mesh: &PolyMesh, he: &HalfEdges, cut: f64) -> PolyMesh {
         })
         .collect();
     let mut faces = Vec::with_capacity(mesh.faces.len() + p.len());
+    let mut out = FaceAttributes::with_capacity(mesh.faces.len() + p.len());
     for f in 0..mesh.faces.len() {
+        out.push_kept(attrs, f as u32);
         let (start, end) = (he.face_start[f], he.face_start[f + 1]);
         // u -> v -> w becomes cut(v->u) -> cut(v->w).
         faces.push(
@@ -95,10 +130,11 @@ fn truncate_once(mesh: &PolyMesh, he: &HalfEdges, cut: f64) -> PolyMesh {
         // runs the other way along that side, is the outgoing list itself.
         let ring = he.outgoing(v);
         if !ring.is_empty() {
+            out.push_child(attrs, he.face[ring[0] as usize], generation, 1);
             faces.push(ring);
         }
     }
-    PolyMesh { points, faces }
+    (PolyMesh { points, faces }, out)
 }
 
 #[cfg(test)]

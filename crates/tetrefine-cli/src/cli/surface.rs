@@ -1,18 +1,20 @@
 //! `tetrefine surface SCHEME IN -o OUT --steps N [options]`.
 
-use std::path::PathBuf;
-use tetrefine_surface::catmull_clark::catmull_clark;
-use tetrefine_surface::catmull_clark_weighted::{catmull_clark_weighted, WeightedConfig};
-use tetrefine_surface::doo_sabin::doo_sabin;
+use std::ops::ControlFlow;
+use std::path::{Path, PathBuf};
+use tetrefine_surface::catmull_clark::catmull_clark_tracked;
+use tetrefine_surface::catmull_clark_weighted::{catmull_clark_weighted_tracked, WeightedConfig};
+use tetrefine_surface::doo_sabin::doo_sabin_tracked;
 use tetrefine_surface::ifs::{
     gasket_control, ifs_attractor, koch_control, write_polylines, PolylineFormat,
 };
-use tetrefine_surface::loop_scheme::loop_subdivide;
-use tetrefine_surface::sierpinski::{sierpinski_with, SierpinskiOptions};
-use tetrefine_surface::sqrt3::{sqrt3, FaceSelection, Sqrt3Options, Sqrt3Rule};
-use tetrefine_surface::truncate::{check_cut, truncate_with};
+use tetrefine_surface::loop_scheme::loop_subdivide_tracked;
+use tetrefine_surface::sierpinski::{sierpinski_tracked, SierpinskiOptions};
+use tetrefine_surface::sqrt3::{sqrt3_tracked, FaceSelection, Sqrt3Options, Sqrt3Rule};
+use tetrefine_surface::truncate::{check_cut, truncate_tracked};
 use tetrefine_surface::{
-    load_surface, read_surface, write_surface, Features, IfsKind, PolyMesh, SurfaceFormat,
+    load_surface, read_surface, write_surface_with, Encoding, FaceAttributes, Features, IfsKind,
+    PolyMesh, StepObserver, Subdivided, SurfaceFormat, WriteOptions,
 };
 
 /// The surface schemes.
@@ -61,12 +63,24 @@ pub struct Args {
     /// Subdivision scheme.
     #[arg(value_enum)]
     pub scheme: Scheme,
-    /// Input surface (.obj, .off, .ply); for ifs, its points are the control
-    /// points (optional for --kind koch and gasket).
+    /// Input surface (.obj, .off, .ply, .stl; PLY and STL ASCII or binary);
+    /// for ifs, its points are the control points (optional for --kind koch
+    /// and gasket).
     pub input: Option<PathBuf>,
-    /// Output surface (.obj, .off, .ply, .vtp, .vtk); for ifs, polylines (.vtp, .csv).
+    /// Output surface (.obj, .off, .ply, .stl, .vtp, .vtk); for ifs,
+    /// polylines (.vtp, .csv). .ply and .stl are binary unless --ascii; .stl
+    /// holds triangles only (other faces are split into fans). .ply, .vtp and
+    /// .vtk carry per-face generation, origin (input face) and group.
     #[arg(short, long)]
     pub output: PathBuf,
+    /// Write .ply and .stl outputs as text instead of binary.
+    #[arg(long)]
+    pub ascii: bool,
+    /// Write every generation, the input as generation 0, to its own file:
+    /// OUTPUT with _K before the extension (-o out.vtp writes out_0.vtp,
+    /// out_1.vtp, …, out_N.vtp for --steps N); OUTPUT itself is not written.
+    #[arg(long)]
+    pub every_step: bool,
     /// Number of subdivision steps (for ifs: rounds of the maps).
     #[arg(long, visible_alias = "iterations", default_value_t = 1)]
     pub steps: usize,
@@ -128,7 +142,10 @@ const MAX_FACES: f64 = 2.0e8;
 /// Peak bytes per projected face (the projection below counts face sides
 /// of the input times the growth per step): `VmHWM` 627 MB for Loop ×10
 /// on a tetrahedron (3.1 M projected, 199 bytes each) and 148 MB for
-/// Catmull–Clark ×9 (786 k projected, 189 bytes each), rounded up.
+/// Catmull–Clark ×9 (786 k projected, 189 bytes each), rounded up. The
+/// per-face attributes (generation, origin, group) add about 7%: Loop ×9 on
+/// a tetrahedron, 786 k projected, 170 MB without them and 181 MB with
+/// them (231 bytes each).
 const BYTES_PER_PROJECTED_FACE: f64 = 300.0;
 
 fn parse_crease(s: &str) -> Result<[u32; 2], String> {
@@ -182,6 +199,9 @@ fn check_options(a: &Args, features: &Features) -> Result<(), String> {
     if let Some(cut) = a.cut {
         check_cut(cut).map_err(|e| format!("--cut: {e}"))?;
     }
+    if a.scheme == Scheme::Ifs && (a.ascii || a.every_step) {
+        return Err("--ascii and --every-step are for surface outputs, not ifs".into());
+    }
     if a.scheme == Scheme::Ifs {
         if a.kind.is_none() {
             return Err(
@@ -196,7 +216,7 @@ fn check_options(a: &Args, features: &Features) -> Result<(), String> {
             return Err("ifs needs an input file with the control points (optional only for --kind koch and gasket)".into());
         }
     } else if a.input.is_none() {
-        return Err("give the input surface (.obj, .off or .ply)".into());
+        return Err("give the input surface (.obj, .off, .ply or .stl)".into());
     }
     Ok(())
 }
@@ -251,7 +271,13 @@ pub fn run(a: Args) -> super::CliResult {
     if a.scheme == Scheme::Ifs {
         return run_ifs(&a);
     }
-    SurfaceFormat::of(&a.output).map_err(|e| e.to_string())?;
+    let format = SurfaceFormat::of(&a.output).map_err(|e| e.to_string())?;
+    if a.ascii && !matches!(format, SurfaceFormat::Ply | SurfaceFormat::Stl) {
+        return Err(format!(
+            "--ascii is for .ply and .stl outputs; {} is text already",
+            a.output.display()
+        ));
+    }
     let is_sqrt3 = matches!(
         a.scheme,
         Scheme::Sqrt3 | Scheme::Sqrt3Interp | Scheme::Sqrt3Linear
@@ -294,7 +320,43 @@ pub fn run(a: Args) -> super::CliResult {
     )?;
     let ctx = |e: tetrefine_surface::SubdivisionError| format!("{}: {e}", input.display());
     let ctx2 = |e: tetrefine_surface::SurfaceError| format!("{}: {e}", input.display());
-    let out: PolyMesh = match a.scheme {
+    let what = format!(
+        "{}{}",
+        a.input
+            .as_ref()
+            .map_or_else(String::new, |p| format!("{}: ", p.display())),
+        format!("{:?}", a.scheme).to_lowercase()
+    );
+    let encoding = if a.ascii {
+        Encoding::Ascii
+    } else {
+        Encoding::Binary
+    };
+    // With --every-step, each generation is checked and written as it comes;
+    // the first failure stops the subdivision.
+    let mut failure: Option<String> = None;
+    let mut write_step = |k: usize, m: &PolyMesh, at: &FaceAttributes| {
+        let path = step_path(&a.output, k);
+        let done = if k == 0 {
+            Ok(())
+        } else {
+            super::guard::check_surface_output(m, &format!("{what}, step {k}"))
+        }
+        .and_then(|()| write_with_attributes(&path, m, at, encoding));
+        match done {
+            Ok(()) => ControlFlow::Continue(()),
+            Err(e) => {
+                failure = Some(e);
+                ControlFlow::Break(())
+            }
+        }
+    };
+    let observer: Option<&mut StepObserver> = if a.every_step {
+        Some(&mut write_step)
+    } else {
+        None
+    };
+    let out: Subdivided = match a.scheme {
         Scheme::Sqrt3 | Scheme::Sqrt3Interp | Scheme::Sqrt3Linear => {
             let rule = match a.scheme {
                 Scheme::Sqrt3 => Sqrt3Rule::Approximating,
@@ -318,41 +380,84 @@ pub fn run(a: Args) -> super::CliResult {
                 features,
                 selection,
             };
-            sqrt3(&mesh, rule, a.steps, &opts).map_err(ctx)?
+            sqrt3_tracked(&mesh, rule, a.steps, &opts, observer).map_err(ctx)?
         }
-        Scheme::Loop => loop_subdivide(&mesh, a.steps, &features).map_err(ctx)?,
-        Scheme::CatmullClark => catmull_clark(&mesh, a.steps, &features).map_err(ctx)?,
-        Scheme::DooSabin => doo_sabin(&mesh, a.steps).map_err(ctx)?,
+        Scheme::Loop => loop_subdivide_tracked(&mesh, a.steps, &features, observer).map_err(ctx)?,
+        Scheme::CatmullClark => {
+            catmull_clark_tracked(&mesh, a.steps, &features, observer).map_err(ctx)?
+        }
+        Scheme::DooSabin => doo_sabin_tracked(&mesh, a.steps, observer).map_err(ctx)?,
         Scheme::CatmullClarkWeighted => {
             let cfg = weights.unwrap_or_default();
-            catmull_clark_weighted(&mesh, a.steps, &cfg, &features).map_err(ctx)?
+            catmull_clark_weighted_tracked(&mesh, a.steps, &cfg, &features, observer)
+                .map_err(ctx)?
         }
         Scheme::Sierpinski => {
             let mut opts = SierpinskiOptions::default();
             if let Some(neck) = a.neck {
                 opts.neck = neck;
             }
-            sierpinski_with(&mesh, a.steps, &opts).map_err(ctx2)?
+            sierpinski_tracked(&mesh, a.steps, &opts, observer).map_err(ctx2)?
         }
-        Scheme::Truncate => truncate_with(&mesh, a.steps, a.cut.unwrap_or(0.25)).map_err(ctx2)?,
+        Scheme::Truncate => {
+            truncate_tracked(&mesh, a.steps, a.cut.unwrap_or(0.25), observer).map_err(ctx2)?
+        }
         Scheme::Ifs => return run_ifs(&a),
     };
-    let input = a
-        .input
-        .as_ref()
-        .map_or_else(String::new, |p| format!("{}: ", p.display()));
-    super::guard::check_surface_output(
-        &out,
-        &format!("{input}{}", format!("{:?}", a.scheme).to_lowercase()),
-    )?;
-    write_surface(&a.output, &out).map_err(|e| e.to_string())?;
+    if let Some(e) = failure {
+        return Err(e);
+    }
+    let out_path = if a.every_step {
+        step_path(&a.output, out.steps)
+    } else {
+        super::guard::check_surface_output(&out.mesh, &what)?;
+        write_with_attributes(&a.output, &out.mesh, &out.attributes, encoding)?;
+        a.output.clone()
+    };
+    let m = &out.mesh;
+    if a.every_step {
+        eprintln!(
+            "wrote {} files, {} to {}",
+            out.steps + 1,
+            step_path(&a.output, 0).display(),
+            out_path.display()
+        );
+    }
     eprintln!(
         "wrote {}: {} vertices, {} edges, {} faces, Euler characteristic {}",
-        a.output.display(),
-        out.used_vertices(),
-        out.edge_list().len(),
-        out.faces.len(),
-        out.euler_characteristic()
+        out_path.display(),
+        m.used_vertices(),
+        m.edge_list().len(),
+        m.faces.len(),
+        m.euler_characteristic()
     );
     Ok(())
+}
+
+/// The file of generation `k` for --every-step: `OUT` with `_k` before the
+/// extension (`out.vtp` → `out_3.vtp`).
+pub fn step_path(output: &Path, k: usize) -> PathBuf {
+    let stem = output
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let name = match output.extension() {
+        Some(ext) => format!("{stem}_{k}.{}", ext.to_string_lossy()),
+        None => format!("{stem}_{k}"),
+    };
+    output.with_file_name(name)
+}
+
+/// Writes a surface with its face attributes (where the format has room).
+fn write_with_attributes(
+    path: &Path,
+    mesh: &PolyMesh,
+    attributes: &FaceAttributes,
+    encoding: Encoding,
+) -> Result<(), String> {
+    let options = WriteOptions {
+        encoding,
+        attributes: Some(attributes),
+    };
+    write_surface_with(path, mesh, &options).map_err(|e| e.to_string())
 }

@@ -157,8 +157,8 @@ fn bad_input_fails_cleanly() {
             "fewer steps",
         ),
         (
-            vec!["surface", "catmull-clark", s(&quad), "-o", "out.stl"],
-            "'.stl'",
+            vec!["surface", "catmull-clark", s(&quad), "-o", "out.3ds"],
+            "'.3ds'",
         ),
     ];
     for (args, needle) in cases {
@@ -688,4 +688,251 @@ fn sierpinski_truncate_and_ifs_refuse_bad_options_cleanly() {
     for (args, needle, out) in cases {
         fails_cleanly(&args, needle, out);
     }
+}
+
+/// The `generation` cell array of a `.vtp`, read by vtkio.
+fn vtp_cell_array(path: &Path, name: &str) -> Vec<u32> {
+    let vtk = vtkio::Vtk::import(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let piece = match vtk.data {
+        vtkio::model::DataSet::PolyData { pieces, .. } => match pieces.into_iter().next() {
+            Some(vtkio::model::Piece::Inline(p)) => *p,
+            _ => panic!("inline piece expected"),
+        },
+        _ => panic!("PolyData expected"),
+    };
+    for attr in piece.data.cell {
+        if let vtkio::model::Attribute::DataArray(arr) = attr {
+            if arr.name == name {
+                return arr.data.cast_into().expect("u32 values");
+            }
+        }
+    }
+    panic!("{}: no cell array {name}", path.display())
+}
+
+#[test]
+fn stl_and_ply_are_binary_unless_ascii_and_stl_reads_back() {
+    let dir = tempfile::tempdir().unwrap();
+    let ico = dir.path().join("ico.obj");
+    write_surface(&ico, &icosahedron()).unwrap();
+    let cube_in = dir.path().join("cube.off");
+    write_surface(&cube_in, &cube()).unwrap();
+    // Loop ×2 on the icosahedron: 20·4² triangles, 84 + 50 bytes each.
+    let stl = dir.path().join("ico2.stl");
+    let (ok, err) = run(&["surface", "loop", s(&ico), "-o", s(&stl), "--steps", "2"]);
+    assert!(ok, "{err}");
+    let bytes = std::fs::read(&stl).unwrap();
+    assert_eq!(bytes.len(), 84 + 50 * 320);
+    assert_eq!(
+        u32::from_le_bytes([bytes[80], bytes[81], bytes[82], bytes[83]]),
+        320
+    );
+    // Catmull–Clark ×1 on the cube: 24 quads, each two STL triangles.
+    let cc = dir.path().join("cc.stl");
+    let (ok, err) = run(&["surface", "catmull-clark", s(&cube_in), "-o", s(&cc)]);
+    assert!(ok, "{err}");
+    assert_eq!(std::fs::metadata(&cc).unwrap().len(), 84 + 50 * 48);
+    // --ascii: text, one "facet normal" per triangle.
+    let asc = dir.path().join("cc-ascii.stl");
+    let (ok, err) = run(&[
+        "surface",
+        "catmull-clark",
+        s(&cube_in),
+        "-o",
+        s(&asc),
+        "--ascii",
+    ]);
+    assert!(ok, "{err}");
+    let text = std::fs::read_to_string(&asc).unwrap();
+    assert!(text.starts_with("solid "));
+    assert_eq!(text.matches("facet normal").count(), 48);
+    assert_eq!(text.matches("endfacet").count(), 48);
+    // STL as input: the ASCII file of 48 triangles is a closed surface of
+    // 26 vertices; Loop ×1 gives 4 × 48 triangles.
+    let again = dir.path().join("again.obj");
+    let (ok, err) = run(&["surface", "loop", s(&asc), "-o", s(&again)]);
+    assert!(ok, "{err}");
+    let m = load_surface(&again).unwrap();
+    assert_eq!(m.faces.len(), 4 * 48);
+    assert_eq!(m.euler_characteristic(), 2);
+    // PLY: binary by default, ASCII on request; both read back.
+    for (flag, format) in [
+        (None, "binary_little_endian 1.0"),
+        (Some("--ascii"), "ascii 1.0"),
+    ] {
+        let ply = dir.path().join("ico.ply");
+        let mut args = vec!["surface", "loop", s(&ico), "-o", s(&ply)];
+        args.extend(flag);
+        let (ok, err) = run(&args);
+        assert!(ok, "{err}");
+        let bytes = std::fs::read(&ply).unwrap();
+        let end = bytes
+            .windows(11)
+            .position(|w| w == b"end_header\n")
+            .unwrap();
+        let head = String::from_utf8_lossy(&bytes[..end]).into_owned();
+        assert!(head.contains(&format!("format {format}\n")), "{head}");
+        assert!(head.contains("property uint generation"), "{head}");
+        assert_eq!(load_surface(&ply).unwrap().faces.len(), 80);
+    }
+    // --ascii is refused where it means nothing.
+    let obj = dir.path().join("x.obj");
+    fails_cleanly(
+        &["surface", "loop", s(&ico), "-o", s(&obj), "--ascii"],
+        "--ascii is for .ply and .stl outputs",
+        &obj,
+    );
+}
+
+#[test]
+fn every_step_writes_each_generation_with_its_attributes() {
+    let dir = tempfile::tempdir().unwrap();
+    let ico = dir.path().join("ico.obj");
+    write_surface(&ico, &icosahedron()).unwrap();
+    let out = dir.path().join("loop.vtp");
+    let (ok, err) = run(&[
+        "surface",
+        "loop",
+        s(&ico),
+        "-o",
+        s(&out),
+        "--steps",
+        "3",
+        "--every-step",
+    ]);
+    assert!(ok, "{err}");
+    assert!(!out.exists(), "OUTPUT itself is not written");
+    for k in 0..=3u32 {
+        let path = dir.path().join(format!("loop_{k}.vtp"));
+        let text = std::fs::read_to_string(&path).unwrap();
+        let faces = 20 * 4usize.pow(k);
+        assert_eq!(vtp_count(&text, "NumberOfPolys"), faces, "step {k}");
+        // Loop replaces every face: all of generation k, 4^k per input
+        // face, and 4^(k−1) of each of the 4 child groups per input face.
+        let generation = vtp_cell_array(&path, "generation");
+        assert_eq!(generation, vec![k; faces], "step {k}");
+        let origin = vtp_cell_array(&path, "origin");
+        for f in 0..20 {
+            let n = origin.iter().filter(|&&o| o == f).count();
+            assert_eq!(n, 4usize.pow(k), "step {k}, input face {f}");
+        }
+        let group = vtp_cell_array(&path, "group");
+        let top = if k == 0 { 0 } else { 3 };
+        assert!(group.iter().all(|&g| g <= top), "step {k}");
+    }
+    assert!(!dir.path().join("loop_4.vtp").exists());
+    // Doo–Sabin on the cube, ASCII PLY: the group property counts the
+    // F-faces (6), E-faces (12) and V-faces (8) of one step.
+    let cube_in = dir.path().join("cube.obj");
+    write_surface(&cube_in, &cube()).unwrap();
+    let ply = dir.path().join("ds.ply");
+    let (ok, err) = run(&[
+        "surface",
+        "doo-sabin",
+        s(&cube_in),
+        "-o",
+        s(&ply),
+        "--every-step",
+        "--ascii",
+    ]);
+    assert!(ok, "{err}");
+    let text = std::fs::read_to_string(dir.path().join("ds_1.ply")).unwrap();
+    let lines: Vec<&str> = text.lines().collect();
+    let end = lines.iter().position(|l| *l == "end_header").unwrap();
+    let nv: usize = lines[..end]
+        .iter()
+        .find_map(|l| l.strip_prefix("element vertex "))
+        .unwrap()
+        .parse()
+        .unwrap();
+    let mut groups = [0; 3];
+    for l in &lines[end + 1 + nv..] {
+        let nums: Vec<usize> = l.split_whitespace().map(|t| t.parse().unwrap()).collect();
+        let n = nums[0];
+        assert_eq!(nums.len(), n + 4, "{l}");
+        groups[nums[n + 3]] += 1;
+    }
+    assert_eq!(groups, [6, 12, 8]);
+    let first = std::fs::read_to_string(dir.path().join("ds_0.ply")).unwrap();
+    assert!(first.contains("element face 6\n"));
+}
+
+#[test]
+fn sierpinski_output_fed_back_goes_on_as_one_run() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("tet.obj");
+    write_surface(&input, &tetrahedron()).unwrap();
+    let sierpinski = |from: &Path, to: &Path, steps: &str| {
+        let (ok, err) = run(&[
+            "surface",
+            "sierpinski",
+            s(from),
+            "-o",
+            s(to),
+            "--steps",
+            steps,
+        ]);
+        assert!(ok, "{err}");
+        ClosedTopology::of(&load_surface(to).unwrap())
+    };
+    // One step, fed back for one more (through .obj and through binary
+    // .ply), is the two-step surface: V = 4, E = 6 give genus
+    // 1 − V + E(4² + 2)/6 = 15 and S = 48, P = 16, J = 30.
+    let once = dir.path().join("once.obj");
+    sierpinski(&input, &once, "1");
+    let once_ply = dir.path().join("once.ply");
+    sierpinski(&input, &once_ply, "1");
+    let direct = sierpinski(&input, &dir.path().join("direct.obj"), "2");
+    for fed in [&once, &once_ply] {
+        let t = sierpinski(fed, &dir.path().join("again.obj"), "1");
+        assert_eq!(t.components, 1);
+        assert_eq!(1 - t.euler() / 2, 15);
+        assert_eq!(
+            (t.vertices, t.edges, t.faces),
+            (48 + 16 + 4 * 30, 2 * 48 + 9 * 30, 48 + 16 + 3 * 30)
+        );
+        assert_eq!(
+            (t.vertices, t.edges, t.faces),
+            (direct.vertices, direct.edges, direct.faces)
+        );
+    }
+    // --every-step: a generation refused (step 2's tubes round onto their
+    // joints at --neck 1e-17) leaves none of the files, not even those of
+    // steps 0 and 1, and no temporary file.
+    let sub = dir.path().join("sub");
+    std::fs::create_dir(&sub).unwrap();
+    let every = sub.join("s.obj");
+    let (ok, err) = run(&[
+        "surface",
+        "sierpinski",
+        s(&input),
+        "-o",
+        s(&every),
+        "--steps",
+        "2",
+        "--every-step",
+        "--neck",
+        "1e-17",
+    ]);
+    assert!(!ok);
+    assert!(
+        err.contains("step 2: the result has coincident points"),
+        "{err}"
+    );
+    assert_eq!(std::fs::read_dir(&sub).unwrap().count(), 0);
+    // --every-step is not for ifs.
+    let lines = dir.path().join("koch.csv");
+    fails_cleanly(
+        &[
+            "surface",
+            "ifs",
+            "--kind",
+            "koch",
+            "-o",
+            s(&lines),
+            "--every-step",
+        ],
+        "not ifs",
+        &lines,
+    );
 }

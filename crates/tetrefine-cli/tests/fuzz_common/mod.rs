@@ -100,6 +100,42 @@ property float z\nelement face 6\nproperty list uchar int vertex_indices\nend_he
 0 0 0\n1 0 0\n1 1 0\n0 1 0\n0 0 1\n1 0 1\n1 1 1\n0 1 1\n\
 4 0 3 2 1\n4 4 5 6 7\n4 0 1 5 4\n4 1 2 6 5\n4 2 3 7 6\n4 3 0 4 7\n";
 
+/// The unit cube of [`CUBE_PLY`] as a binary little-endian `.ply`.
+fn cube_ply_binary() -> Vec<u8> {
+    let mut b = b"ply\nformat binary_little_endian 1.0\nelement vertex 8\nproperty float x\n\
+property float y\nproperty float z\nelement face 6\nproperty list uchar int vertex_indices\n\
+end_header\n"
+        .to_vec();
+    for p in [
+        [0f32, 0., 0.],
+        [1., 0., 0.],
+        [1., 1., 0.],
+        [0., 1., 0.],
+        [0., 0., 1.],
+        [1., 0., 1.],
+        [1., 1., 1.],
+        [0., 1., 1.],
+    ] {
+        for c in p {
+            b.extend_from_slice(&c.to_le_bytes());
+        }
+    }
+    for f in [
+        [0i32, 3, 2, 1],
+        [4, 5, 6, 7],
+        [0, 1, 5, 4],
+        [1, 2, 6, 5],
+        [2, 3, 7, 6],
+        [3, 0, 4, 7],
+    ] {
+        b.push(4);
+        for v in f {
+            b.extend_from_slice(&v.to_le_bytes());
+        }
+    }
+    b
+}
+
 /// The triangles of the unit cube, outward.
 fn cube_triangles() -> Vec<[[f32; 3]; 3]> {
     let p = |i: usize| [(i & 1) as f32, ((i >> 1) & 1) as f32, ((i >> 2) & 1) as f32];
@@ -332,6 +368,24 @@ pub fn seeds() -> Vec<Seed> {
         "surface .ply",
         "s.ply",
         CUBE_PLY.into(),
+        Kind::Surface,
+    ));
+    s.push(seed(
+        "surface .ply binary",
+        "s.ply",
+        cube_ply_binary(),
+        Kind::Surface,
+    ));
+    s.push(seed(
+        "surface .stl ascii",
+        "s.stl",
+        stl_ascii(),
+        Kind::Surface,
+    ));
+    s.push(seed(
+        "surface .stl binary",
+        "s.stl",
+        stl_binary(),
         Kind::Surface,
     ));
     s.push(seed(

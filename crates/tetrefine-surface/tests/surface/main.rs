@@ -5,7 +5,9 @@ mod support;
 
 mod shapes;
 
+mod formats;
 mod io;
+mod lineage;
 mod polymesh;
 mod schemes;
 mod sqrt3;
