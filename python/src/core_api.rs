@@ -612,11 +612,10 @@ pub fn refine(
         // stops when no edge is long or no split was possible.
         let sopts = tetrefine::SizeOptions {
             quality_floor: None,
-            improve: tetrefine::ImproveOptions {
-                passes: a.opt_passes,
-                threshold: a.threshold,
-                ..tetrefine::ImproveOptions::default()
-            },
+            // `effort` and `hausd` as the √3 step's optimize phase.
+            improve: opts
+                .effort
+                .improve_options(a.opt_passes, a.threshold, opts.hausd),
         };
         for s in 1..=a.steps {
             hook(s, "size", mesh.n_tets() as u64);

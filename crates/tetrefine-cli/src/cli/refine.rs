@@ -386,11 +386,9 @@ pub fn run(a: Args) -> super::CliResult {
         // an anisotropic map), so the worst never drops below the input's.
         let sopts = tetrefine::SizeOptions {
             quality_floor: None,
-            improve: tetrefine::ImproveOptions {
-                passes: a.opt_passes,
-                threshold: a.threshold,
-                ..tetrefine::ImproveOptions::default()
-            },
+            // The size loop's optimize phase honours --effort and --hausd
+            // as the √3 step's does.
+            improve: a.effort.improve_options(a.opt_passes, a.threshold, a.hausd),
         };
         let mut last = None;
         for s in 1..=n_steps {

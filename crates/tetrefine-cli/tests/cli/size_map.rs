@@ -377,3 +377,50 @@ fn indicator_sol_is_read_as_an_indicator_with_a_note_and_size_sol_as_sizes() {
     assert!(!err.contains("error indicator"), "{err}");
     assert!(err.contains("size pass 1"), "{err}");
 }
+
+/// The positions of a mesh's boundary points, bit for bit.
+fn boundary_points(m: &TetMesh) -> std::collections::HashSet<[u64; 3]> {
+    m.tet_ids()
+        .flat_map(|t| {
+            (0..4)
+                .filter(move |&f| m.is_boundary_face(t, f))
+                .map(move |f| (t, f))
+        })
+        .flat_map(|(t, f)| m.face_vertices(t, f))
+        .map(|v| m.point(v).to_array().map(f64::to_bits))
+        .collect()
+}
+
+/// The size loop's optimize phase follows `--effort` and `--hausd` as the √3
+/// step's does. With `fast` no boundary point of the tripod moves, so every
+/// input boundary point is still there, bit for bit (midpoint splits only
+/// add points); with `--hausd 0` boundary points may slide only where the
+/// surface is flat, so the domain's volume is the input's (to round-off);
+/// with the default effort and bound, points slide on the curved patches
+/// too, and the volume changes.
+#[test]
+fn the_size_loop_honours_effort_and_hausd() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = load_mesh(&crate::support::path("meshes/tripod.mesh"))
+        .unwrap()
+        .0;
+    let (before, volume) = (boundary_points(&input), MeshStats::compute(&input).volume);
+    let refined = |extra: &[&str]| {
+        let out = dir.path().join("o.mesh");
+        let mut args = vec!["--hsiz", "2.5"];
+        args.extend_from_slice(extra);
+        refine_ok("meshes/tripod.mesh", &out, &args);
+        let m = load_mesh(&out).unwrap().0;
+        let missing = before.difference(&boundary_points(&m)).count();
+        let change = (MeshStats::compute(&m).volume - volume).abs() / volume;
+        (missing, change)
+    };
+    assert_eq!(refined(&["--effort", "fast"]).0, 0);
+    let (_, change) = refined(&["--hausd", "0"]);
+    assert!(change <= 1e-12, "--hausd 0: volume changed by {change:e}");
+    let (missing, change) = refined(&[]);
+    assert!(
+        missing > 0 && change > 1e-9,
+        "default: {missing} moved, {change:e}"
+    );
+}
