@@ -66,6 +66,11 @@ pub struct BoundarySmoothOptions {
     /// the Hausdorff bound ([`crate::ops::remove_boundary_cap`]); off for
     /// the linear rule, whose domain must stay the input's exactly.
     pub remove_caps: bool,
+    /// Flip boundary edges where it raises the worst tet of their ring and
+    /// the surface stays within the Hausdorff bound
+    /// ([`crate::ops::flip_boundary_edge`]; exactly coplanar faces only when
+    /// `crease_angle` is [`FLAT_ONLY`]).
+    pub flip_edges: bool,
 }
 
 impl Default for BoundarySmoothOptions {
@@ -80,6 +85,7 @@ impl Default for BoundarySmoothOptions {
             laplacian_threshold: 0.5,
             crease_angle: 45.0,
             remove_caps: true,
+            flip_edges: false,
         }
     }
 }

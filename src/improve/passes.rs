@@ -9,6 +9,7 @@
 //! (closed rings inside one region) are removed, so the domain, its regions
 //! and its tags are untouched.
 
+use super::boundary_smooth::FLAT_ONLY;
 use super::boundary_smooth::{BoundarySmoothOptions, BoundarySmoothReport, BoundarySmoother};
 use super::colour::{colour_balls_except, sequential_levels, Balls};
 use super::laplacian::{laplacian_position_in, BallNow};
@@ -22,6 +23,7 @@ use crate::mesh::{edge_key, EdgeKey, TetMesh};
 use crate::ops::edge_removal::{apply_ring_triangulation, RingTriangulation};
 use crate::ops::edge_removal::{best_ring_triangulation_above, RingScratch};
 use crate::ops::EdgeRing;
+use crate::ops::{boundary_flip_ring, flip_boundary_edge, BoundaryFlipLimits, TetsAtVertex};
 use crate::ops::{is_cap_below, remove_boundary_cap, CapLimits};
 use crate::topo::scatter::Shared;
 use crate::topo::{EDGE_OF, TET_EDGES};
@@ -105,6 +107,8 @@ pub struct ImproveReport {
     pub caps_removed: usize,
     /// Long edges split at their midpoint ([`ImproveOptions::long_edge_factor`]).
     pub long_edges_split: usize,
+    /// Boundary edges flipped ([`crate::ops::flip_boundary_edge`]).
+    pub boundary_flips: usize,
 }
 
 impl ImproveReport {
@@ -118,6 +122,7 @@ impl ImproveReport {
         self.line_moves += other.line_moves;
         self.caps_removed += other.caps_removed;
         self.long_edges_split += other.long_edges_split;
+        self.boundary_flips += other.boundary_flips;
     }
 }
 
@@ -245,9 +250,94 @@ pub fn improve(mesh: &mut TetMesh, opts: &ImproveOptions) -> ImproveReport {
     if let Some(b) = &opts.boundary {
         if opts.passes > 0 {
             cap_pass(mesh, &mut tr, b, opts, &mut report);
+            // Flips go last: before the smoother, a flip's new faces would
+            // be its reference surface too, and the smoother undoes them.
+            if b.flip_edges {
+                boundary_flip_pass(mesh, &mut tr, b, opts, &mut report);
+            }
         }
     }
     report
+}
+
+/// 2-2 (and m → 2m − 2) flips of boundary edges ([`flip_boundary_edge`]) of
+/// the tets below `b.threshold` with a boundary face, where the flip raises
+/// the worst tet of the edge's ring and the two faces are one patch within
+/// the Hausdorff bound of `b` (absolute, or relative to the faces' mean edge
+/// length; exactly coplanar faces only when `b` allows flat stars only, as
+/// for the linear rule). One sweep in slot order. Returns the number of
+/// flips.
+fn boundary_flip_pass(
+    mesh: &mut TetMesh,
+    tr: &mut Tracker,
+    b: &BoundarySmoothOptions,
+    opts: &ImproveOptions,
+    report: &mut ImproveReport,
+) -> usize {
+    let bar = b.threshold.max(opts.threshold);
+    let candidates: Vec<u32> = (0..mesh.n_tet_slots() as u32)
+        .filter(|&t| {
+            mesh.is_alive(t)
+                && tr.tq[t as usize] < bar
+                && tr.is_allowed(t)
+                && mesh.adj(t).contains(&crate::mesh::NO_ADJ)
+        })
+        .collect();
+    let mut counts = TetsAtVertex::new(mesh);
+    let mut flipped = 0;
+    for t in candidates {
+        'faces: for f in 0..4 {
+            if !mesh.is_alive(t) || tr.tq[t as usize] >= bar {
+                break;
+            }
+            if !mesh.is_boundary_face(t, f) {
+                continue;
+            }
+            for (e, [i, j]) in TET_EDGES.iter().enumerate() {
+                if *i == f || *j == f {
+                    continue;
+                }
+                // The face's third corner: local ids sum to 0+1+2+3 = 6.
+                let k = 6 - f - i - j;
+                let p = mesh.tet_points(t);
+                let mean_edge =
+                    (p[*i].distance(p[*j]) + p[*i].distance(p[k]) + p[*j].distance(p[k])) / 3.0;
+                let limits = BoundaryFlipLimits {
+                    exact: b.crease_angle <= FLAT_ONLY,
+                    hausd: b.hausd.unwrap_or(b.hausd_rel * mean_edge),
+                    crease_angle: b.crease_angle,
+                };
+                let Ok(ring) = boundary_flip_ring(mesh, t, e, limits, &counts) else {
+                    continue;
+                };
+                if !ring.tets.iter().all(|&u| tr.is_allowed(u)) {
+                    continue;
+                }
+                let beat = ring
+                    .tets
+                    .iter()
+                    .map(|&u| tr.tq[u as usize])
+                    .fold(f64::INFINITY, f64::min);
+                let old = ring.tets.clone();
+                if let Ok(new) = flip_boundary_edge(mesh, t, e, limits, beat, &mut counts) {
+                    tr.grow(mesh.n_tet_slots());
+                    for u in old {
+                        tr.tq[u as usize] = f64::INFINITY;
+                    }
+                    for u in new {
+                        if let Some(a) = &mut tr.allowed {
+                            a[u as usize] = true;
+                        }
+                        tr.set(mesh, u, tet_min_sine(&mesh.tet_points(u)));
+                    }
+                    flipped += 1;
+                    break 'faces;
+                }
+            }
+        }
+    }
+    report.boundary_flips += flipped;
+    flipped
 }
 
 /// Removes the boundary caps (tets with two boundary faces) below

@@ -416,3 +416,51 @@ fn linear_boundary_moves_keep_region_volumes_of_boxes() {
         }
     }
 }
+
+/// Boundary 2-2 flips in `improve` (`BoundarySmoothOptions::flip_edges`,
+/// off by default: measured below): on every small mesh after one fast
+/// step, with only exactly coplanar faces allowed (crease angle 0), flips
+/// happen, never lower the worst angle, and keep the domain exactly: its
+/// volume, and the count of boundary faces (a flip trades two for two).
+#[test]
+fn boundary_flips_keep_the_domain_and_the_worst() {
+    for name in SMALL {
+        let mut m = load(name, Some(45.0));
+        refine_step(
+            &mut m,
+            1,
+            &RefineOptions {
+                effort: tetrefine::Effort::Fast,
+                ..Default::default()
+            },
+        );
+        let before = MeshStats::compute(&m);
+        let worst = checked_worst(&m, name);
+        // One pass with the passes' own bars at (about) zero: only the
+        // flip sweep after it works (the boundary smoother's bar, 0.4, picks
+        // its candidates).
+        let opts = ImproveOptions {
+            passes: 1,
+            threshold: 1e-9,
+            laplacian_threshold: 0.0,
+            edge_threshold: 0.0,
+            boundary: Some(tetrefine::BoundarySmoothOptions {
+                crease_angle: 0.0,
+                flip_edges: true,
+                ..Default::default()
+            }),
+            ..Default::default()
+        };
+        let r = improve(&mut m, &opts);
+        let after = MeshStats::compute(&m);
+        assert!(r.boundary_flips > 0, "{name}: no flip");
+        assert!(checked_worst(&m, name) >= worst, "{name}: worst fell");
+        assert!(
+            (after.volume - before.volume).abs() <= 1e-12 * before.volume,
+            "{name}: volume {} -> {}",
+            before.volume,
+            after.volume
+        );
+        assert_eq!(after.boundary_faces, before.boundary_faces, "{name}");
+    }
+}
