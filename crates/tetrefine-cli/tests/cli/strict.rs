@@ -749,23 +749,19 @@ f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\n",
     .unwrap();
     let out = dir.path().join("o.obj");
     let o_ = out.to_str().unwrap();
+    let surface = |scheme: &str, input: &Path, extra: &[&str]| {
+        let mut args = vec!["surface", scheme, input.to_str().unwrap(), "-o", o_];
+        args.extend_from_slice(&["--steps", "2"]);
+        args.extend_from_slice(extra);
+        tetrefine(&args)
+    };
     for (scheme, input, opt, v) in [
         ("sierpinski", &tet, "--neck", "1e-300"),
         ("sierpinski", &tet, "--neck", "1e-17"),
         ("truncate", &cube, "--cut", "1e-300"),
         ("truncate", &cube, "--cut", "1e-17"),
     ] {
-        let o = tetrefine(&[
-            "surface",
-            scheme,
-            input.to_str().unwrap(),
-            "-o",
-            o_,
-            "--steps",
-            "2",
-            opt,
-            v,
-        ]);
+        let o = surface(scheme, input, &[opt, v]);
         assert_eq!(
             o.status.code(),
             Some(1),
@@ -781,15 +777,7 @@ f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\n",
     }
     // The defaults are fine.
     for (scheme, input) in [("sierpinski", &tet), ("truncate", &cube)] {
-        let o = tetrefine(&[
-            "surface",
-            scheme,
-            input.to_str().unwrap(),
-            "-o",
-            o_,
-            "--steps",
-            "2",
-        ]);
+        let o = surface(scheme, input, &[]);
         assert!(o.status.success(), "{scheme}: {}", stderr(&o));
     }
 }
