@@ -821,6 +821,15 @@ pub fn ifs_shape(
             if let Some(i) = mesh.points.iter().position(|p| !p.is_finite()) {
                 return Err(SurfaceError::NonFinite { vertex: i });
             }
+            for (f, face) in mesh.faces.iter().enumerate() {
+                if let Some(&v) = face.iter().find(|&&v| v as usize >= mesh.points.len()) {
+                    return Err(SurfaceError::VertexOutOfRange {
+                        face: f,
+                        vertex: v,
+                        count: mesh.points.len(),
+                    });
+                }
+            }
             (
                 mesh.points.iter().map(|&x| ifs.lift(x)).collect(),
                 mesh.faces.clone(),
@@ -903,7 +912,15 @@ fn attractor_shape(full: &Ifs, ifs: &Ifs, k: usize) -> Result<IfsShape, SurfaceE
         }
         kind if kind.is_curve() => {
             check_size(ifs, 2, k)?;
-            let ends = [full.fixed_point(0), full.fixed_point(nfull - 1)];
+            let m = full.dimension();
+            let ends = if matches!(kind, IfsKind::ClampedCubicBSpline | IfsKind::Bezier) {
+                // These curves interpolate their end control points: the
+                // fixed points are exactly the unit weights.
+                let unit = |j: usize| (0..m).map(|i| f64::from(u8::from(i == j))).collect();
+                [unit(0), unit(m - 1)]
+            } else {
+                [full.fixed_point(0), full.fixed_point(nfull - 1)]
+            };
             let q = ifs.map_count();
             let mut lines: Vec<Vec<DVec3>> = Vec::new();
             let mut previous: Option<u128> = None;

@@ -298,6 +298,12 @@ fn maps_are_contractive() {
         (IfsKind::Bicubic { nu: 5, nv: 4 }, grid(5, 4)),
         (IfsKind::Koch, koch_control().to_vec()),
         (IfsKind::Gasket, gasket_control().to_vec()),
+        (IfsKind::ClampedCubicBSpline, curve[..4].to_vec()),
+        (IfsKind::ClampedCubicBSpline, curve.clone()),
+        (IfsKind::Bezier, curve[..2].to_vec()),
+        (IfsKind::Bezier, curve.clone()),
+        (IfsKind::Loop, bumpy_net(IfsKind::Loop).1),
+        (IfsKind::Sqrt3, bumpy_net(IfsKind::Sqrt3).1),
     ];
     let mut rng = SplitMix64(3);
     for (kind, control) in cases {
@@ -864,8 +870,7 @@ fn bezier_union_of_halves_is_the_bernstein_curve() {
                 "n = {n}, t = {t}"
             );
         }
-        assert!(line[0].distance(p[0]) < 1e-12);
-        assert!(line[1 << k].distance(p[n - 1]) < 1e-12);
+        assert_eq!((line[0], line[1 << k]), (p[0], p[n - 1]), "exact ends");
     }
 }
 
@@ -1305,6 +1310,18 @@ fn new_kinds_refuse_wrong_control_counts() {
         ifs_shape(IfsKind::Sqrt3, &p, 9, &IfsOptions::default()),
         Err(SurfaceError::TooLarge { .. })
     ));
+    let bad_start = IfsOptions {
+        maps: None,
+        start: IfsStart::Mesh(PolyMesh::new(vec![DVec3::ZERO; 3], vec![vec![0, 1, 3]])),
+    };
+    assert_eq!(
+        ifs_shape(IfsKind::Sqrt3, &p, 1, &bad_start).unwrap_err(),
+        SurfaceError::VertexOutOfRange {
+            face: 0,
+            vertex: 3,
+            count: 3
+        }
+    );
 }
 
 #[test]
