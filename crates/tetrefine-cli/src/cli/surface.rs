@@ -14,8 +14,8 @@ use tetrefine_surface::sierpinski::{sierpinski_tracked, SierpinskiOptions};
 use tetrefine_surface::sqrt3::{sqrt3_tracked, FaceSelection, Sqrt3Options, Sqrt3Rule};
 use tetrefine_surface::truncate::{check_cut, truncate_tracked};
 use tetrefine_surface::{
-    load_surface, read_surface, write_surface, write_surface_with, Encoding, FaceAttributes,
-    Features, IfsKind, PolyMesh, StepObserver, Subdivided, SurfaceFormat, WriteOptions,
+    load_surface, read_surface, write_surface_with, Encoding, FaceAttributes, Features, IfsKind,
+    PolyMesh, StepObserver, Subdivided, SurfaceFormat, WriteOptions,
 };
 
 /// The surface schemes.
@@ -77,11 +77,11 @@ pub struct Args {
     #[arg(value_enum)]
     pub scheme: Scheme,
     /// Input surface (.obj, .off, .ply, .stl; PLY and STL ASCII or binary);
-    /// for ifs, its points are the control points (optional for --kind koch
-    /// and gasket).
+    /// for ifs, its points are the control points (optional for --kind koch,
+    /// gasket, loop and sqrt3).
     pub input: Option<PathBuf>,
-    /// Output surface (.obj, .off, .ply, .stl, .vtp, .vtk); for ifs,
-    /// polylines (.vtp, .csv). .ply and .stl are binary unless --ascii; .stl
+    /// Output surface (.obj, .off, .ply, .stl, .vtp, .vtk); for ifs, curves,
+    /// segments and points as .vtp or .csv, surfaces and triangles as a mesh. .ply and .stl are binary unless --ascii; .stl
     /// holds triangles only (other faces are split into fans). .ply, .vtp and
     /// .vtk carry per-face generation, origin (input face) and group.
     #[arg(short, long)]
@@ -224,8 +224,8 @@ fn check_options(a: &Args, features: &Features) -> Result<(), String> {
     if let Some(cut) = a.cut {
         check_cut(cut).map_err(|e| format!("--cut: {e}"))?;
     }
-    if a.scheme == Scheme::Ifs && (a.ascii || a.every_step) {
-        return Err("--ascii and --every-step are for surface outputs, not ifs".into());
+    if a.scheme == Scheme::Ifs && a.every_step {
+        return Err("--every-step is for the subdivision schemes, not ifs".into());
     }
     if a.scheme == Scheme::Ifs {
         if a.kind.is_none() {
@@ -300,11 +300,23 @@ fn run_ifs(a: &Args) -> super::CliResult {
     };
     match output {
         IfsOutput::Surface => {
-            SurfaceFormat::of(&a.output)
+            let format = SurfaceFormat::of(&a.output)
                 .map_err(|e| format!("{e} (ifs writes a triangle mesh here)"))?;
+            if a.ascii && !matches!(format, SurfaceFormat::Ply | SurfaceFormat::Stl) {
+                return Err(format!(
+                    "--ascii is for .ply and .stl outputs; {} is text already",
+                    a.output.display()
+                ));
+            }
         }
         IfsOutput::Polylines | IfsOutput::Points => {
             PolylineFormat::of(&a.output).map_err(|e| e.to_string())?;
+            if a.ascii {
+                return Err(format!(
+                    "--ascii is for .ply and .stl surface outputs; {} is text already",
+                    a.output.display()
+                ));
+            }
         }
     }
     let (control, source) = match &a.input {
@@ -335,7 +347,15 @@ fn run_ifs(a: &Args) -> super::CliResult {
         ifs_shape(kind, &control, a.steps, &options).map_err(|e| format!("{source}: {e}"))?;
     match shape {
         IfsShape::Surface(mesh) => {
-            write_surface(&a.output, &mesh).map_err(|e| e.to_string())?;
+            let options = WriteOptions {
+                encoding: if a.ascii {
+                    Encoding::Ascii
+                } else {
+                    Encoding::Binary
+                },
+                attributes: None,
+            };
+            write_surface_with(&a.output, &mesh, &options).map_err(|e| e.to_string())?;
             eprintln!(
                 "wrote {}: {} vertices, {} triangles",
                 a.output.display(),

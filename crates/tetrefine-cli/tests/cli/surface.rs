@@ -791,9 +791,23 @@ fn ifs_loop_sqrt3_surfaces_map_subsets_and_start_sets() {
         s(&start),
         "--steps",
         "2",
+        "--ascii",
     ]);
     assert!(ok, "{err}");
     assert_eq!((ply_count(&o, "vertex"), ply_count(&o, "face")), (64, 32));
+    assert!(std::fs::read_to_string(&o)
+        .unwrap()
+        .contains("format ascii"));
+    let (ok, err) = run(&[
+        "surface",
+        "ifs",
+        "-o",
+        s(&out("k.csv")),
+        "--kind",
+        "koch",
+        "--ascii",
+    ]);
+    assert!(!ok && err.contains("--ascii is for .ply and .stl"), "{err}");
     // Refused: bad maps, an unreadable start file, a wrong control count,
     // a curve extension for a surface; no output file, no panic.
     let o = out("bad.obj");
@@ -1194,7 +1208,7 @@ fn sierpinski_output_fed_back_goes_on_as_one_run() {
             s(&lines),
             "--every-step",
         ],
-        "not ifs",
+        "--every-step is for the subdivision schemes, not ifs",
         &lines,
     );
 }
