@@ -1351,3 +1351,62 @@ fn bicubic_surface_is_a_triangle_mesh_of_patch_points() {
     assert!(mesh.validate().is_ok());
     assert_eq!(mesh.euler_characteristic(), 1);
 }
+
+/// Distance in the plane `z = 0` from `x` to the triangle `abc`.
+fn distance_to_triangle(x: DVec3, [a, b, c]: [DVec3; 3]) -> f64 {
+    let cross = |u: DVec3, v: DVec3| u.x * v.y - u.y * v.x;
+    let area = cross(b - a, c - a);
+    let inside = [(a, b), (b, c), (c, a)]
+        .iter()
+        .all(|&(p, q)| cross(q - p, x - p) * area >= 0.0);
+    if inside {
+        return 0.0;
+    }
+    [(a, b), (b, c), (c, a)]
+        .iter()
+        .map(|&(p, q)| {
+            let t = ((x - p).dot(q - p) / (q - p).length_squared()).clamp(0.0, 1.0);
+            x.distance(p + t * (q - p))
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
+#[test]
+fn surface_ifs_from_a_far_mesh_converges_to_the_patch() {
+    // On the regular planar net the patch is the triangle (0,0), (1,0),
+    // (1/2, √3/2) itself; a mesh far outside it is pulled onto it, the
+    // farthest point's distance shrinking by the subdominant factor (1/2 for
+    // Loop per step, 1/3 for √3 per double step) up to constants.
+    let tri = [
+        DVec3::ZERO,
+        DVec3::X,
+        DVec3::new(0.5, 3f64.sqrt() / 2.0, 0.0),
+    ];
+    let far = PolyMesh::new(
+        vec![
+            DVec3::new(6.0, 5.0, 0.0),
+            DVec3::new(9.0, 5.0, 0.0),
+            DVec3::new(7.0, 8.0, 0.0),
+        ],
+        vec![vec![0, 1, 2]],
+    );
+    for (kind, k1, k2, factor) in [(IfsKind::Loop, 3, 7, 16.0), (IfsKind::Sqrt3, 2, 4, 9.0)] {
+        let p = regular_net(kind).expect("net");
+        let worst = |k: usize| {
+            let opts = IfsOptions {
+                maps: None,
+                start: IfsStart::Mesh(far.clone()),
+            };
+            let IfsShape::Surface(m) = ifs_shape(kind, &p, k, &opts).expect("shape") else {
+                panic!("surface")
+            };
+            m.points
+                .iter()
+                .map(|&x| distance_to_triangle(x, tri))
+                .fold(0.0, f64::max)
+        };
+        let (d1, d2) = (worst(k1), worst(k2));
+        assert!(d1 > 1e-3, "{kind:?}: {d1}");
+        assert!(d2 < d1 / factor, "{kind:?}: {d1} then {d2}");
+    }
+}
