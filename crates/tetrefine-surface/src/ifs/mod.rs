@@ -163,7 +163,9 @@ const SQRT3_NET_RADIUS: i64 = 2;
 /// The first three are the patch triangle `(0,0), (1,0), (0,1)`; then every
 /// lattice point within distance 1 (Loop: the 12-point net of the regular
 /// box-spline patch) or 2 (√3, 27 points) of it, by distance, then by `j`,
-/// then by `i`. `None` for the other kinds.
+/// then by `i`. `None` for the other kinds. (√3 needs the larger net: after
+/// two steps a corner sub-triangle's 12-point net holds centroids of
+/// neighbouring coarse triangles, whose rules reach distance 2.)
 ///
 /// Map order: Loop — corner sub-triangles at vertices 0, 1, 2, then the
 /// centre. √3 (two steps, a split into thirds) — the corners at vertices 0,

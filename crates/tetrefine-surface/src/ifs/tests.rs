@@ -1410,3 +1410,32 @@ fn surface_ifs_from_a_far_mesh_converges_to_the_patch() {
         assert!(d2 < d1 / factor, "{kind:?}: {d1} then {d2}");
     }
 }
+
+#[test]
+fn the_nets_are_the_smallest_closed_ones() {
+    // Loop closes on the 12-point net; √3 does not (its rules after two
+    // steps need points at distance 2), and closes on the 27-point net.
+    assert!(
+        lattice::lattice_maps(&lattice::net(1), &lattice::LOOP_SUBS, lattice::loop_fine).is_ok()
+    );
+    assert!(
+        lattice::lattice_maps(&lattice::net(0), &lattice::LOOP_SUBS, lattice::loop_fine).is_err()
+    );
+    assert!(
+        lattice::lattice_maps(&lattice::net(1), &lattice::SQRT3_SUBS, lattice::sqrt3_fine).is_err()
+    );
+    assert!(
+        lattice::lattice_maps(&lattice::net(2), &lattice::SQRT3_SUBS, lattice::sqrt3_fine).is_ok()
+    );
+    // Every map's rows are affine combinations.
+    for kind in [IfsKind::Loop, IfsKind::Sqrt3] {
+        let ifs = Ifs::new(kind, &regular_net(kind).expect("net")).expect("ifs");
+        let m = ifs.dimension();
+        for i in 0..ifs.map_count() {
+            for r in 0..m {
+                let sum: f64 = ifs.map(i)[r * m..(r + 1) * m].iter().sum();
+                assert!((sum - 1.0).abs() < 1e-14, "{kind:?} map {i} row {r}");
+            }
+        }
+    }
+}
