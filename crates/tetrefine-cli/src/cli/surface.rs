@@ -334,10 +334,9 @@ fn run_ifs(a: &Args) -> super::CliResult {
             (builtin, name)
         }
     };
+    let ifs = tetrefine_surface::Ifs::new(kind, &control).map_err(|e| format!("{source}: {e}"))?;
     if let Some(keep) = &a.maps {
-        tetrefine_surface::Ifs::new(kind, &control)
-            .and_then(|ifs| ifs.subset(keep))
-            .map_err(|e| format!("{source}: --maps: {e}"))?;
+        ifs.subset(keep).map_err(|e| format!("--maps: {e}"))?;
     }
     let options = IfsOptions {
         maps: a.maps.clone(),
