@@ -6,7 +6,8 @@ use tetrefine_surface::catmull_clark::catmull_clark_tracked;
 use tetrefine_surface::catmull_clark_weighted::{catmull_clark_weighted_tracked, WeightedConfig};
 use tetrefine_surface::doo_sabin::doo_sabin_tracked;
 use tetrefine_surface::ifs::{
-    gasket_control, ifs_attractor, koch_control, write_polylines, PolylineFormat,
+    gasket_control, ifs_shape, koch_control, regular_net, write_points_csv, write_points_vtp,
+    write_polylines, IfsOptions, IfsShape, IfsStart, PolylineFormat,
 };
 use tetrefine_surface::loop_scheme::loop_subdivide_tracked;
 use tetrefine_surface::sierpinski::{sierpinski_tracked, SierpinskiOptions};
@@ -38,7 +39,8 @@ pub enum Scheme {
     Sierpinski,
     /// Chaikin vertex truncation, every edge cut at --cut and 1 − cut (closed surfaces).
     Truncate,
-    /// Attractor of the IFS of a subdivision scheme (--kind); writes polylines (.vtp, .csv).
+    /// Attractor of the IFS of a subdivision scheme (--kind); curves as polylines
+    /// (.vtp, .csv), surfaces (bicubic, loop, sqrt3) as triangle meshes.
     Ifs,
 }
 
@@ -55,6 +57,17 @@ pub enum IfsKindArg {
     Koch,
     /// Sierpinski gasket (6 control points; the standard ones without input).
     Gasket,
+    /// End-interpolating cubic B-spline (knots of multiplicity 4 at the ends;
+    /// at least 4 control points).
+    ClampedBspline,
+    /// Bézier curve of degree n − 1 (at least 2 control points).
+    Bezier,
+    /// Regular Loop patch over one triangle (12 control points of a triangular
+    /// net; the regular planar net without input).
+    Loop,
+    /// Regular √3 patch over one triangle (27 control points of a triangular
+    /// net; the regular planar net without input).
+    Sqrt3,
 }
 
 /// Arguments of `surface`.
@@ -64,11 +77,11 @@ pub struct Args {
     #[arg(value_enum)]
     pub scheme: Scheme,
     /// Input surface (.obj, .off, .ply, .stl; PLY and STL ASCII or binary);
-    /// for ifs, its points are the control points (optional for --kind koch
-    /// and gasket).
+    /// for ifs, its points are the control points (optional for --kind koch,
+    /// gasket, loop and sqrt3).
     pub input: Option<PathBuf>,
-    /// Output surface (.obj, .off, .ply, .stl, .vtp, .vtk); for ifs,
-    /// polylines (.vtp, .csv). .ply and .stl are binary unless --ascii; .stl
+    /// Output surface (.obj, .off, .ply, .stl, .vtp, .vtk); for ifs, curves,
+    /// segments and points as .vtp or .csv, surfaces and triangles as a mesh. .ply and .stl are binary unless --ascii; .stl
     /// holds triangles only (other faces are split into fans). .ply, .vtp and
     /// .vtk carry per-face generation, origin (input face) and group.
     #[arg(short, long)]
@@ -135,6 +148,16 @@ pub struct Args {
     /// ifs --kind bicubic only: the control grid size, "NU,NV".
     #[arg(long, value_delimiter = ',', value_name = "NU,NV")]
     pub grid: Option<Vec<usize>>,
+    /// ifs only: keep only these maps (0-based, comma separated), a fractal
+    /// on the curve or surface; q kept maps make q^N pieces after N steps.
+    #[arg(long, value_delimiter = ',', value_name = "I,J,…")]
+    pub maps: Option<Vec<usize>>,
+    /// ifs only: the set the maps are applied to: point (the first control
+    /// point), segment (first to last control point), triangle (first,
+    /// middle, last control point), or a mesh FILE (.obj, .off, .ply, .stl);
+    /// default: points on the attractor.
+    #[arg(long, value_name = "point|segment|triangle|FILE")]
+    pub start: Option<String>,
 }
 
 /// Faces above which a run is refused rather than exhausting memory.
@@ -178,6 +201,8 @@ fn check_options(a: &Args, features: &Features) -> Result<(), String> {
     only(a.neck.is_some(), "--neck", Scheme::Sierpinski, "sierpinski")?;
     only(a.cut.is_some(), "--cut", Scheme::Truncate, "truncate")?;
     only(a.kind.is_some(), "--kind", Scheme::Ifs, "ifs")?;
+    only(a.maps.is_some(), "--maps", Scheme::Ifs, "ifs")?;
+    only(a.start.is_some(), "--start", Scheme::Ifs, "ifs")?;
     if a.grid.is_some() && a.kind != Some(IfsKindArg::Bicubic) {
         return Err("--grid is for ifs --kind bicubic".into());
     }
@@ -199,21 +224,25 @@ fn check_options(a: &Args, features: &Features) -> Result<(), String> {
     if let Some(cut) = a.cut {
         check_cut(cut).map_err(|e| format!("--cut: {e}"))?;
     }
-    if a.scheme == Scheme::Ifs && (a.ascii || a.every_step) {
-        return Err("--ascii and --every-step are for surface outputs, not ifs".into());
+    if a.scheme == Scheme::Ifs && a.every_step {
+        return Err("--every-step is for the subdivision schemes, not ifs".into());
     }
     if a.scheme == Scheme::Ifs {
         if a.kind.is_none() {
             return Err(
-                "ifs needs --kind cubic-bspline, four-point, bicubic, koch or gasket".into(),
+                "ifs needs --kind cubic-bspline, four-point, bicubic, koch, gasket, clamped-bspline, bezier, loop or sqrt3".into(),
             );
         }
         if a.kind == Some(IfsKindArg::Bicubic) && a.grid.as_ref().is_none_or(|g| g.len() != 2) {
             return Err("ifs --kind bicubic needs --grid NU,NV (the control grid size)".into());
         }
-        if a.input.is_none() && !matches!(a.kind, Some(IfsKindArg::Koch) | Some(IfsKindArg::Gasket))
+        if a.input.is_none()
+            && !matches!(
+                a.kind,
+                Some(IfsKindArg::Koch | IfsKindArg::Gasket | IfsKindArg::Loop | IfsKindArg::Sqrt3)
+            )
         {
-            return Err("ifs needs an input file with the control points (optional only for --kind koch and gasket)".into());
+            return Err("ifs needs an input file with the control points (optional only for --kind koch, gasket, loop and sqrt3)".into());
         }
     } else if a.input.is_none() {
         return Err("give the input surface (.obj, .off, .ply or .stl)".into());
@@ -221,9 +250,16 @@ fn check_options(a: &Args, features: &Features) -> Result<(), String> {
     Ok(())
 }
 
-/// `surface ifs`: the attractor as polylines.
+/// What `surface ifs` writes.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum IfsOutput {
+    Points,
+    Polylines,
+    Surface,
+}
+
+/// `surface ifs`: the attractor as points, polylines or a triangle mesh.
 fn run_ifs(a: &Args) -> super::CliResult {
-    PolylineFormat::of(&a.output).map_err(|e| e.to_string())?;
     let kind = match a.kind {
         Some(IfsKindArg::CubicBspline) => IfsKind::CubicBSpline,
         Some(IfsKindArg::FourPoint) => IfsKind::FourPoint,
@@ -235,24 +271,115 @@ fn run_ifs(a: &Args) -> super::CliResult {
             }
         }
         Some(IfsKindArg::Koch) => IfsKind::Koch,
+        Some(IfsKindArg::ClampedBspline) => IfsKind::ClampedCubicBSpline,
+        Some(IfsKindArg::Bezier) => IfsKind::Bezier,
+        Some(IfsKindArg::Loop) => IfsKind::Loop,
+        Some(IfsKindArg::Sqrt3) => IfsKind::Sqrt3,
         Some(IfsKindArg::Gasket) | None => IfsKind::Gasket,
     };
+    let start = match a.start.as_deref() {
+        None => IfsStart::Attractor,
+        Some("point") => IfsStart::Point,
+        Some("segment") => IfsStart::Segment,
+        Some("triangle") => IfsStart::Triangle,
+        Some(file) => {
+            let path = Path::new(file);
+            let f = read_surface(path).map_err(|e| format!("--start: {e}"))?;
+            IfsStart::Mesh(f.mesh)
+        }
+    };
+    // The output's kind, known before any work, so a wrong extension is
+    // refused first.
+    let output = match &start {
+        IfsStart::Attractor if kind.is_surface() => IfsOutput::Surface,
+        IfsStart::Attractor | IfsStart::Segment => IfsOutput::Polylines,
+        IfsStart::Point => IfsOutput::Points,
+        IfsStart::Triangle => IfsOutput::Surface,
+        IfsStart::Mesh(m) if m.faces.is_empty() => IfsOutput::Points,
+        IfsStart::Mesh(_) => IfsOutput::Surface,
+    };
+    match output {
+        IfsOutput::Surface => {
+            let format = SurfaceFormat::of(&a.output)
+                .map_err(|e| format!("{e} (ifs writes a triangle mesh here)"))?;
+            if a.ascii && !matches!(format, SurfaceFormat::Ply | SurfaceFormat::Stl) {
+                return Err(format!(
+                    "--ascii is for .ply and .stl outputs; {} is text already",
+                    a.output.display()
+                ));
+            }
+        }
+        IfsOutput::Polylines | IfsOutput::Points => {
+            PolylineFormat::of(&a.output).map_err(|e| e.to_string())?;
+            if a.ascii {
+                return Err(format!(
+                    "--ascii is for .ply and .stl surface outputs; {} is text already",
+                    a.output.display()
+                ));
+            }
+        }
+    }
     let (control, source) = match &a.input {
         Some(path) => {
             let file = read_surface(path).map_err(|e| e.to_string())?;
             (file.mesh.points, path.display().to_string())
         }
-        None if kind == IfsKind::Koch => (koch_control().to_vec(), "--kind koch".to_string()),
-        None => (gasket_control().to_vec(), "--kind gasket".to_string()),
+        None => {
+            let name = format!("--kind {:?}", kind).to_lowercase();
+            let builtin = match kind {
+                IfsKind::Koch => koch_control().to_vec(),
+                IfsKind::Gasket => gasket_control().to_vec(),
+                _ => regular_net(kind).unwrap_or_default(),
+            };
+            (builtin, name)
+        }
     };
-    let lines = ifs_attractor(kind, &control, a.steps).map_err(|e| format!("{source}: {e}"))?;
-    write_polylines(&a.output, &lines).map_err(|e| e.to_string())?;
-    eprintln!(
-        "wrote {}: {} polylines, {} points",
-        a.output.display(),
-        lines.len(),
-        lines.iter().map(Vec::len).sum::<usize>()
-    );
+    let ifs = tetrefine_surface::Ifs::new(kind, &control).map_err(|e| format!("{source}: {e}"))?;
+    if let Some(keep) = &a.maps {
+        ifs.subset(keep).map_err(|e| format!("--maps: {e}"))?;
+    }
+    let options = IfsOptions {
+        maps: a.maps.clone(),
+        start,
+    };
+    let shape =
+        ifs_shape(kind, &control, a.steps, &options).map_err(|e| format!("{source}: {e}"))?;
+    match shape {
+        IfsShape::Surface(mesh) => {
+            let options = WriteOptions {
+                encoding: if a.ascii {
+                    Encoding::Ascii
+                } else {
+                    Encoding::Binary
+                },
+                attributes: None,
+            };
+            write_surface_with(&a.output, &mesh, &options).map_err(|e| e.to_string())?;
+            eprintln!(
+                "wrote {}: {} vertices, {} triangles",
+                a.output.display(),
+                mesh.points.len(),
+                mesh.faces.len()
+            );
+        }
+        IfsShape::Polylines(lines) => {
+            write_polylines(&a.output, &lines).map_err(|e| e.to_string())?;
+            eprintln!(
+                "wrote {}: {} polylines, {} points",
+                a.output.display(),
+                lines.len(),
+                lines.iter().map(Vec::len).sum::<usize>()
+            );
+        }
+        IfsShape::Points(points) => {
+            match PolylineFormat::of(&a.output).map_err(|e| e.to_string())? {
+                PolylineFormat::Csv => write_points_csv(&a.output, &points),
+                PolylineFormat::Vtp => write_points_vtp(&a.output, &points),
+            }
+            .map_err(|e| e.to_string())?;
+            eprintln!("wrote {}: {} points", a.output.display(), points.len());
+        }
+    }
     Ok(())
 }
 

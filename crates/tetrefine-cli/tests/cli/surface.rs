@@ -535,9 +535,9 @@ fn ifs_curves_and_patches_from_input_control_points() {
     let line = &read_polylines_csv(&csv)[0];
     assert_eq!(line.len(), 9);
     assert!(close(line[0], p[2]) && close(line[4], p[3]) && close(line[8], p[4]));
-    // Bicubic 4 × 4 patch: (2^k + 1) rows and as many columns of 2^k + 1
-    // points; the corner (0,0) is Σ (1,4,1)ᵢ(1,4,1)ⱼ/36 over the first 3 × 3
-    // control points.
+    // Bicubic 4 × 4 patch: a triangle mesh on the (2^k + 1)² grid of patch
+    // points, two triangles per grid square; the corner (0,0) is
+    // Σ (1,4,1)ᵢ(1,4,1)ⱼ/36 over the first 3 × 3 control points.
     let grid: Vec<DVec3> = (0..16)
         .map(|i| {
             let (u, v) = ((i / 4) as f64, (i % 4) as f64);
@@ -545,7 +545,7 @@ fn ifs_curves_and_patches_from_input_control_points() {
         })
         .collect();
     let patch = write_points("patch.obj", &grid);
-    let out = dir.path().join("patch.csv");
+    let out = dir.path().join("patch_out.obj");
     let (ok, err) = run(&[
         "surface",
         "ifs",
@@ -560,15 +560,291 @@ fn ifs_curves_and_patches_from_input_control_points() {
         "2",
     ]);
     assert!(ok, "{err}");
-    let lines = read_polylines_csv(&out);
-    assert_eq!(lines.len(), 10);
-    assert!(lines.iter().all(|l| l.len() == 5));
+    let mesh = load_surface(&out).unwrap();
+    assert_eq!(mesh.points.len(), 25);
+    assert_eq!(mesh.faces.len(), 32);
+    assert!(mesh.faces.iter().all(|f| f.len() == 3));
     let w = [1.0, 4.0, 1.0];
     let corner: DVec3 = (0..3)
         .flat_map(|a| (0..3).map(move |b| (a, b)))
         .map(|(a, b)| grid[a * 4 + b] * w[a] * w[b] / 36.0)
         .sum();
-    assert!(close(lines[0][0], corner), "{} vs {corner}", lines[0][0]);
+    assert!(
+        mesh.points.iter().any(|&x| close(x, corner)),
+        "corner {corner} missing"
+    );
+}
+
+/// The regular triangular net of `surface ifs --kind loop` (12 points) or
+/// `sqrt3` (27 points), lattice point (i, j) at i e1 + j e2, lifted by a
+/// bump: the order of the README (corners of the patch triangle first, then
+/// by distance from it, then by j, then by i).
+fn triangle_net_file(dir: &Path, name: &str, radius: i64) -> std::path::PathBuf {
+    let hex = |i: i64, j: i64| (i.abs() + j.abs() + (i + j).abs()) / 2;
+    let corners = [(0, 0), (1, 0), (0, 1)];
+    let mut pts = Vec::new();
+    for j in -4..=4i64 {
+        for i in -4..=4i64 {
+            let d = corners
+                .iter()
+                .map(|&(a, b)| hex(i - a, j - b))
+                .min()
+                .unwrap();
+            if d <= radius {
+                let c = corners.iter().position(|&q| q == (i, j)).unwrap_or(3);
+                pts.push((d, c, j, i));
+            }
+        }
+    }
+    pts.sort();
+    let text: String = pts
+        .iter()
+        .map(|&(_, _, j, i)| {
+            let (x, y) = (i as f64 + 0.5 * j as f64, 0.75f64.sqrt() * j as f64);
+            format!(
+                "v {x} {y} {}\n",
+                0.5 * (-(x - 0.5).powi(2) - (y - 0.3).powi(2)).exp()
+            )
+        })
+        .collect();
+    let path = dir.join(name);
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+/// `element NAME N` from a binary or ASCII PLY header.
+fn ply_count(path: &Path, element: &str) -> usize {
+    let bytes = std::fs::read(path).unwrap();
+    let end = bytes.windows(10).position(|w| w == b"end_header").unwrap();
+    let header = String::from_utf8_lossy(&bytes[..end]).into_owned();
+    let key = format!("element {element} ");
+    let line = header.lines().find(|l| l.starts_with(&key)).unwrap();
+    line[key.len()..].trim().parse().unwrap()
+}
+
+#[test]
+fn ifs_loop_sqrt3_surfaces_map_subsets_and_start_sets() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let out = |name: &str| d.join(name);
+    // Loop, builtin planar net, 3 steps: (2^3+1)(2^3+2)/2 = 45 vertices and
+    // 4^3 triangles, the patch triangle itself (z = 0).
+    let o = out("loop.obj");
+    let (ok, err) = run(&[
+        "surface",
+        "ifs",
+        "-o",
+        s(&o),
+        "--kind",
+        "loop",
+        "--steps",
+        "3",
+    ]);
+    assert!(ok, "{err}");
+    let m = load_surface(&o).unwrap();
+    assert_eq!((m.points.len(), m.faces.len()), (45, 64));
+    assert!(m.points.iter().all(|p| p.z == 0.0));
+    // √3 from a bumpy 27-point net, 2 steps: (9+1)(9+2)/2 = 55 vertices, 81
+    // triangles, binary PLY.
+    let net = triangle_net_file(d, "net27.obj", 2);
+    let o = out("sqrt3.ply");
+    let (ok, err) = run(&[
+        "surface",
+        "ifs",
+        s(&net),
+        "-o",
+        s(&o),
+        "--kind",
+        "sqrt3",
+        "--steps",
+        "2",
+    ]);
+    assert!(ok, "{err}");
+    assert_eq!((ply_count(&o, "vertex"), ply_count(&o, "face")), (55, 81));
+    // Loop with the three corner maps: a gasket on the surface, 3^4
+    // triangles on (3^5 + 3)/2 = 123 vertices, in .vtp.
+    let net12 = triangle_net_file(d, "net12.obj", 1);
+    let o = out("gasket.vtp");
+    let (ok, err) = run(&[
+        "surface",
+        "ifs",
+        s(&net12),
+        "-o",
+        s(&o),
+        "--kind",
+        "loop",
+        "--maps",
+        "0,1,2",
+        "--steps",
+        "4",
+    ]);
+    assert!(ok, "{err}");
+    let text = std::fs::read_to_string(&o).unwrap();
+    assert_eq!(vtp_count(&text, "NumberOfPoints"), 123);
+    assert_eq!(vtp_count(&text, "NumberOfPolys"), 81);
+    // Clamped B-spline and Bézier: start at the first control point, end at
+    // the last, 2^k + 1 points.
+    let curve: Vec<String> = [
+        (0.0, 0.0, 0.0),
+        (1.0, 2.0, 0.0),
+        (3.0, 2.0, 1.0),
+        (4.0, 0.0, 0.0),
+        (5.0, -1.0, 2.0),
+    ]
+    .iter()
+    .map(|(x, y, z)| format!("v {x} {y} {z}\n"))
+    .collect();
+    let cp = out("curve.obj");
+    std::fs::write(&cp, curve.concat()).unwrap();
+    for kind in ["clamped-bspline", "bezier"] {
+        let o = out(&format!("{kind}.csv"));
+        let (ok, err) = run(&[
+            "surface",
+            "ifs",
+            s(&cp),
+            "-o",
+            s(&o),
+            "--kind",
+            kind,
+            "--steps",
+            "5",
+        ]);
+        assert!(ok, "{err}");
+        let lines = read_polylines_csv(&o);
+        assert_eq!(lines.len(), 1);
+        assert_eq!(lines[0].len(), 33);
+        assert!(close(lines[0][0], DVec3::ZERO));
+        assert!(close(lines[0][32], DVec3::new(5.0, -1.0, 2.0)), "{kind}");
+    }
+    // Start sets: Koch from the segment (0,0)–(1,0) is the Koch polygon
+    // (4^k segments of length 3^-k); a point start gives q^k points; a
+    // triangle q^k triangles; a mesh file q^k copies.
+    let o = out("koch.csv");
+    let (ok, err) = run(&[
+        "surface",
+        "ifs",
+        "-o",
+        s(&o),
+        "--kind",
+        "koch",
+        "--start",
+        "segment",
+        "--steps",
+        "2",
+    ]);
+    assert!(ok, "{err}");
+    let segs = read_polylines_csv(&o);
+    assert_eq!(segs.len(), 16);
+    assert!(segs
+        .iter()
+        .all(|l| (l[0].distance(l[1]) - 1.0 / 9.0).abs() < 1e-12));
+    let o = out("points.csv");
+    let (ok, err) = run(&[
+        "surface",
+        "ifs",
+        "-o",
+        s(&o),
+        "--kind",
+        "sqrt3",
+        "--start",
+        "point",
+        "--maps",
+        "0,8",
+        "--steps",
+        "3",
+    ]);
+    assert!(ok, "{err}");
+    let rows = std::fs::read_to_string(&o).unwrap().lines().count();
+    assert_eq!(rows, 1 + 8);
+    let o = out("tris.obj");
+    let (ok, err) = run(&[
+        "surface",
+        "ifs",
+        s(&cp),
+        "-o",
+        s(&o),
+        "--kind",
+        "bezier",
+        "--start",
+        "triangle",
+        "--steps",
+        "4",
+    ]);
+    assert!(ok, "{err}");
+    let m = tetrefine_surface::read_surface(&o).unwrap().mesh;
+    assert_eq!((m.points.len(), m.faces.len()), (48, 16));
+    let start = out("start.obj");
+    std::fs::write(
+        &start,
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 3\nf 2 4 3\n",
+    )
+    .unwrap();
+    let o = out("copies.ply");
+    let (ok, err) = run(&[
+        "surface",
+        "ifs",
+        "-o",
+        s(&o),
+        "--kind",
+        "loop",
+        "--start",
+        s(&start),
+        "--steps",
+        "2",
+        "--ascii",
+    ]);
+    assert!(ok, "{err}");
+    assert_eq!((ply_count(&o, "vertex"), ply_count(&o, "face")), (64, 32));
+    assert!(std::fs::read_to_string(&o)
+        .unwrap()
+        .contains("format ascii"));
+    let (ok, err) = run(&[
+        "surface",
+        "ifs",
+        "-o",
+        s(&out("k.csv")),
+        "--kind",
+        "koch",
+        "--ascii",
+    ]);
+    assert!(!ok && err.contains("--ascii is for .ply and .stl"), "{err}");
+    // Refused: bad maps, an unreadable start file, a wrong control count,
+    // a curve extension for a surface; no output file, no panic.
+    let o = out("bad.obj");
+    for (args, want) in [
+        (
+            vec!["--kind", "loop", "--maps", "0,4"],
+            "map 4 does not exist",
+        ),
+        (
+            vec!["--kind", "loop", "--maps", "1,1"],
+            "map 1 is given twice",
+        ),
+        (
+            vec!["--kind", "loop", "--start", "missing.obj"],
+            "missing.obj",
+        ),
+        (
+            vec![s(&cp), "--kind", "loop"],
+            "Loop needs exactly 12 control points, got 5",
+        ),
+        (
+            vec![s(&net12), "--kind", "sqrt3"],
+            "Sqrt3 needs exactly 27 control points, got 12",
+        ),
+        (vec!["--kind", "koch", "--maps", "x"], "invalid value"),
+    ] {
+        let mut full = vec!["surface", "ifs", "-o", s(&o)];
+        full.extend(args.iter().copied());
+        let (ok, err) = run(&full);
+        assert!(!ok && err.contains(want), "{full:?}: {err}");
+        assert!(!err.contains("panicked"), "{err}");
+        assert!(!o.exists(), "{full:?} wrote a file");
+    }
+    let (ok, err) = run(&["surface", "ifs", "-o", s(&out("x.csv")), "--kind", "loop"]);
+    assert!(!ok && err.contains("triangle mesh"), "{err}");
+    let (ok, err) = run(&["surface", "loop", s(&net12), "-o", s(&o), "--maps", "0"]);
+    assert!(!ok && err.contains("--maps is for ifs"), "{err}");
 }
 
 #[test]
@@ -932,7 +1208,7 @@ fn sierpinski_output_fed_back_goes_on_as_one_run() {
             s(&lines),
             "--every-step",
         ],
-        "not ifs",
+        "--every-step is for the subdivision schemes, not ifs",
         &lines,
     );
 }

@@ -298,6 +298,12 @@ fn maps_are_contractive() {
         (IfsKind::Bicubic { nu: 5, nv: 4 }, grid(5, 4)),
         (IfsKind::Koch, koch_control().to_vec()),
         (IfsKind::Gasket, gasket_control().to_vec()),
+        (IfsKind::ClampedCubicBSpline, curve[..4].to_vec()),
+        (IfsKind::ClampedCubicBSpline, curve.clone()),
+        (IfsKind::Bezier, curve[..2].to_vec()),
+        (IfsKind::Bezier, curve.clone()),
+        (IfsKind::Loop, bumpy_net(IfsKind::Loop).1),
+        (IfsKind::Sqrt3, bumpy_net(IfsKind::Sqrt3).1),
     ];
     let mut rng = SplitMix64(3);
     for (kind, control) in cases {
@@ -734,4 +740,702 @@ fn bad_control_points_are_refused() {
     assert_eq!(koch.apply(0, &[1.0; 9]), koch.apply(0, &[1.0; 5]));
     let msg = Ifs::new(IfsKind::FourPoint, &four).unwrap_err().to_string();
     assert_eq!(msg, "FourPoint needs at least 6 control points, got 4");
+}
+
+// ---------------------------------------------------------------------------
+// Clamped B-spline, Bézier, Loop, √3, subsets, start sets.
+
+/// Cox–de Boor: the cubic B-spline with full knot vector `knots` at `t`
+/// (right-continuous; `t` at the last knot evaluates the last span).
+fn de_boor_curve(p: &[DVec3], knots: &[f64], t: f64) -> DVec3 {
+    let last = *knots.last().expect("knots");
+    let n = p.len();
+    // Degree-0 basis.
+    let mut basis: Vec<f64> = (0..knots.len() - 1)
+        .map(|i| {
+            let inside = knots[i] <= t && t < knots[i + 1];
+            let at_end = t == last && knots[i] < knots[i + 1] && knots[i + 1] == last;
+            if inside || at_end {
+                1.0
+            } else {
+                0.0
+            }
+        })
+        .collect();
+    for d in 1..=3 {
+        basis = (0..knots.len() - 1 - d)
+            .map(|i| {
+                let a = knots[i + d] - knots[i];
+                let b = knots[i + d + 1] - knots[i + 1];
+                let left = if a > 0.0 {
+                    (t - knots[i]) / a * basis[i]
+                } else {
+                    0.0
+                };
+                let right = if b > 0.0 {
+                    (knots[i + d + 1] - t) / b * basis[i + 1]
+                } else {
+                    0.0
+                };
+                left + right
+            })
+            .collect();
+    }
+    (0..n).map(|i| basis[i] * p[i]).sum()
+}
+
+#[test]
+fn clamped_bspline_passes_through_its_ends_and_is_the_de_boor_curve() {
+    for n in [4usize, 5, 6, 9] {
+        let p: Vec<DVec3> = (0..n)
+            .map(|i| DVec3::new(i as f64, ((i * 7) % 5) as f64 - 2.0, (i as f64 * 0.9).cos()))
+            .collect();
+        let l = (n - 3) as f64;
+        let mut knots = vec![0.0; 4];
+        knots.extend((1..n - 3).map(|i| i as f64));
+        knots.extend([l; 4]);
+        let k = 7;
+        let shape =
+            ifs_shape(IfsKind::ClampedCubicBSpline, &p, k, &IfsOptions::default()).expect("shape");
+        let IfsShape::Polylines(lines) = shape else {
+            panic!("a curve is polylines")
+        };
+        assert_eq!(lines.len(), 1);
+        let line = &lines[0];
+        assert_eq!(line.len(), (1 << k) + 1);
+        assert!(line[0].distance(p[0]) < 1e-12, "n = {n}: starts at p_0");
+        assert!(
+            line[line.len() - 1].distance(p[n - 1]) < 1e-12,
+            "ends at p_(n-1)"
+        );
+        for (j, x) in line.iter().enumerate() {
+            let t = l * j as f64 / (1 << k) as f64;
+            let want = de_boor_curve(&p, &knots, t);
+            assert!(x.distance(want) < 1e-12, "n = {n}, t = {t}: {x} vs {want}");
+        }
+    }
+    // The paper's two matrices for knots {0,0,0,1,2,2,2} (five points).
+    let ifs = Ifs::new(IfsKind::ClampedCubicBSpline, &[DVec3::ZERO; 5]).expect("ifs");
+    let s1 = [
+        [1.0, 0.0, 0.0, 0.0, 0.0],
+        [0.5, 0.5, 0.0, 0.0, 0.0],
+        [0.0, 0.75, 0.25, 0.0, 0.0],
+        [0.0, 0.375, 0.5, 0.125, 0.0],
+        [0.0, 0.25, 0.5, 0.25, 0.0],
+    ];
+    let s2 = [
+        [0.0, 0.25, 0.5, 0.25, 0.0],
+        [0.0, 0.125, 0.5, 0.375, 0.0],
+        [0.0, 0.0, 0.25, 0.75, 0.0],
+        [0.0, 0.0, 0.0, 0.5, 0.5],
+        [0.0, 0.0, 0.0, 0.0, 1.0],
+    ];
+    for (i, s) in [s1, s2].iter().enumerate() {
+        let want: Vec<f64> = s.iter().flatten().copied().collect();
+        for (a, b) in ifs.map(i).iter().zip(&want) {
+            assert!((a - b).abs() < 1e-15, "map {i}: {:?}", ifs.map(i));
+        }
+    }
+}
+
+fn binomial(n: usize, k: usize) -> f64 {
+    (0..k).fold(1.0, |acc, i| acc * (n - i) as f64 / (i + 1) as f64)
+}
+
+fn bernstein_curve(p: &[DVec3], t: f64) -> DVec3 {
+    let d = p.len() - 1;
+    (0..=d)
+        .map(|i| binomial(d, i) * t.powi(i as i32) * (1.0 - t).powi((d - i) as i32) * p[i])
+        .sum()
+}
+
+#[test]
+fn bezier_union_of_halves_is_the_bernstein_curve() {
+    for n in [2usize, 3, 4, 7] {
+        let p: Vec<DVec3> = (0..n)
+            .map(|i| DVec3::new((i as f64 * 1.3).sin(), i as f64 * 0.5, ((i * i) % 3) as f64))
+            .collect();
+        let k = 8;
+        let IfsShape::Polylines(lines) =
+            ifs_shape(IfsKind::Bezier, &p, k, &IfsOptions::default()).expect("shape")
+        else {
+            panic!("polylines")
+        };
+        let line = &lines[0];
+        assert_eq!(line.len(), (1 << k) + 1);
+        for (j, x) in line.iter().enumerate() {
+            let t = j as f64 / (1 << k) as f64;
+            assert!(
+                x.distance(bernstein_curve(&p, t)) < 1e-12,
+                "n = {n}, t = {t}"
+            );
+        }
+        assert_eq!((line[0], line[1 << k]), (p[0], p[n - 1]), "exact ends");
+    }
+}
+
+/// The planar position of lattice point `(i, j)`.
+fn lattice_xy(q: [i64; 2]) -> DVec3 {
+    DVec3::new(
+        q[0] as f64 + 0.5 * q[1] as f64,
+        3f64.sqrt() / 2.0 * q[1] as f64,
+        0.0,
+    )
+}
+
+/// A bumpy net: the regular planar net lifted by a smooth height plus a
+/// pseudo-random one.
+fn bumpy_net(kind: IfsKind) -> (Vec<[i64; 2]>, Vec<DVec3>) {
+    let net = triangle_net(kind).expect("net");
+    let mut rng = SplitMix64(11);
+    let pts = net
+        .iter()
+        .map(|&q| {
+            let x = lattice_xy(q);
+            x + DVec3::new(
+                0.05 * rng.next_f64(),
+                0.0,
+                (x.x * 0.8).sin() + 0.3 * rng.next_f64(),
+            )
+        })
+        .collect();
+    (net, pts)
+}
+
+/// The six lattice neighbours, written out independently of the module.
+const RING: [[i64; 2]; 6] = [[1, 0], [1, -1], [0, -1], [-1, 0], [-1, 1], [0, 1]];
+
+/// One regular Loop step on a lattice patch (keys in the current level's
+/// lattice): every fine point whose stencil is available.
+fn loop_step_reference(pts: &HashMap<[i64; 2], DVec3>) -> HashMap<[i64; 2], DVec3> {
+    let mut out = HashMap::new();
+    for (&v, &x) in pts {
+        let ring: Option<Vec<DVec3>> = RING
+            .iter()
+            .map(|d| pts.get(&[v[0] + d[0], v[1] + d[1]]).copied())
+            .collect();
+        if let Some(ring) = ring {
+            out.insert(
+                [2 * v[0], 2 * v[1]],
+                0.625 * x + ring.iter().sum::<DVec3>() / 16.0,
+            );
+        }
+        for d in RING {
+            let w = [v[0] + d[0], v[1] + d[1]];
+            let Some(&y) = pts.get(&w) else { continue };
+            // The two points next to both ends.
+            let common: Vec<DVec3> = RING
+                .iter()
+                .map(|e| [v[0] + e[0], v[1] + e[1]])
+                .filter(|c| RING.iter().any(|f| [w[0] + f[0], w[1] + f[1]] == *c))
+                .filter_map(|c| pts.get(&c).copied())
+                .collect();
+            if common.len() == 2 {
+                out.insert(
+                    [v[0] + w[0], v[1] + w[1]],
+                    0.375 * (x + y) + 0.125 * (common[0] + common[1]),
+                );
+            }
+        }
+    }
+    out
+}
+
+/// One regular Kobbelt √3 step on a lattice patch whose six neighbour
+/// offsets (counter-clockwise) are `dirs`: old points with a full ring are
+/// relaxed (`α = 1/3`), every triangle gets its centroid.
+fn sqrt3_step_reference(
+    pts: &HashMap<[i64; 2], DVec3>,
+    dirs: &[[i64; 2]; 6],
+) -> HashMap<[i64; 2], DVec3> {
+    let mut out = HashMap::new();
+    for (&v, &x) in pts {
+        let ring: Option<Vec<DVec3>> = dirs
+            .iter()
+            .map(|d| pts.get(&[v[0] + d[0], v[1] + d[1]]).copied())
+            .collect();
+        if let Some(ring) = ring {
+            out.insert(v, 2.0 / 3.0 * x + ring.iter().sum::<DVec3>() / 18.0);
+        }
+        for j in 0..6 {
+            let (a, b) = (dirs[j], dirs[(j + 1) % 6]);
+            let (pa, pb) = ([v[0] + a[0], v[1] + a[1]], [v[0] + b[0], v[1] + b[1]]);
+            if let (Some(&ya), Some(&yb)) = (pts.get(&pa), pts.get(&pb)) {
+                let s = [a[0] + b[0], a[1] + b[1]];
+                assert!(s[0] % 3 == 0 && s[1] % 3 == 0, "centroid on the lattice");
+                out.insert([v[0] + s[0] / 3, v[1] + s[1] / 3], (x + ya + yb) / 3.0);
+            }
+        }
+    }
+    out
+}
+
+/// Limit points `v/2 + Σ ring/12` of the level points `(a, b)`, `a, b ≥ 0`,
+/// `a + b ≤ side` (the closed triangle).
+fn limit_points(pts: &HashMap<[i64; 2], DVec3>, side: i64) -> Vec<DVec3> {
+    let mut out = Vec::new();
+    for a in 0..=side {
+        for b in 0..=side - a {
+            let v = pts[&[a, b]];
+            let ring: DVec3 = RING.iter().map(|d| pts[&[a + d[0], b + d[1]]]).sum();
+            out.push(0.5 * v + ring / 12.0);
+        }
+    }
+    out
+}
+
+/// Every point of `want` is a vertex of `mesh` (to 1e-12) and the counts
+/// agree.
+fn same_vertices(mesh: &PolyMesh, want: &[DVec3]) {
+    assert_eq!(mesh.points.len(), want.len());
+    for w in want {
+        let d = mesh
+            .points
+            .iter()
+            .map(|x| x.distance(*w))
+            .fold(f64::INFINITY, f64::min);
+        assert!(d < 1e-12, "limit point {w} is {d} from the mesh");
+    }
+}
+
+fn surface(kind: IfsKind, p: &[DVec3], k: usize, maps: Option<Vec<usize>>) -> PolyMesh {
+    let opts = IfsOptions {
+        maps,
+        start: IfsStart::Attractor,
+    };
+    match ifs_shape(kind, p, k, &opts).expect("shape") {
+        IfsShape::Surface(m) => m,
+        other => panic!("surface expected, got {other:?}"),
+    }
+}
+
+#[test]
+fn loop_ifs_vertices_are_the_loop_limit_points() {
+    // Loop at valence 6 (β = 1/16): the limit position is
+    // (1 − 6χ) v + χ Σ neighbours with χ = 1/(3/(8β) + 6) = 1/12, i.e.
+    // v/2 + Σ/12 (the left eigenvector of the 1-ring subdivision matrix).
+    let (net, p) = bumpy_net(IfsKind::Loop);
+    assert_eq!(net.len(), 12);
+    for k in 1..=4usize {
+        let mesh = surface(IfsKind::Loop, &p, k, None);
+        let side = 1i64 << k;
+        assert_eq!(mesh.faces.len(), 4usize.pow(k as u32));
+        assert_eq!(
+            mesh.points.len() as i64,
+            (side + 1) * (side + 2) / 2,
+            "k = {k}"
+        );
+        let mut pts: HashMap<[i64; 2], DVec3> =
+            net.iter().copied().zip(p.iter().copied()).collect();
+        for _ in 0..k {
+            pts = loop_step_reference(&pts);
+        }
+        same_vertices(&mesh, &limit_points(&pts, side));
+        // Manifold, consistently oriented triangles (a disc).
+        assert!(mesh.validate().is_ok());
+        assert_eq!(mesh.euler_characteristic(), 1);
+    }
+}
+
+#[test]
+fn sqrt3_ifs_vertices_are_the_sqrt3_limit_points() {
+    // Kobbelt's √3 at valence 6 (α = 1/3): on (v, r = mean of the ring) one
+    // step is v' = (1 − α) v + α r and r' = (v + 2r)/3 (the new ring is the
+    // six centroids, whose mean is (v + 2r)/3). The left eigenvector of
+    // [[1 − α, α], [1/3, 2/3]] for eigenvalue 1 is (1, 3α)/(1 + 3α) =
+    // (1/2, 1/2), so the limit is v/2 + r/2 = v/2 + Σ/12.
+    let (net, p) = bumpy_net(IfsKind::Sqrt3);
+    assert_eq!(net.len(), 27);
+    let level1 = [[1, 1], [-1, 2], [-2, 1], [-1, -1], [1, -2], [2, -1]];
+    for k in 1..=3u32 {
+        let mesh = surface(IfsKind::Sqrt3, &p, k as usize, None);
+        let side = 3i64.pow(k);
+        assert_eq!(mesh.faces.len(), 9usize.pow(k));
+        assert_eq!(mesh.points.len() as i64, (side + 1) * (side + 2) / 2);
+        // Keys in units of 3^-k of the coarse lattice.
+        let mut pts: HashMap<[i64; 2], DVec3> = net
+            .iter()
+            .map(|&q| [q[0] * side, q[1] * side])
+            .zip(p.iter().copied())
+            .collect();
+        for t in 0..k {
+            let scale = 3i64.pow(k - t);
+            let dirs = RING.map(|d| [d[0] * scale, d[1] * scale]);
+            pts = sqrt3_step_reference(&pts, &dirs);
+            let scale = 3i64.pow(k - t - 1);
+            let dirs = level1.map(|d: [i64; 2]| [d[0] * scale, d[1] * scale]);
+            pts = sqrt3_step_reference(&pts, &dirs);
+        }
+        same_vertices(&mesh, &limit_points(&pts, side));
+        assert!(mesh.validate().is_ok());
+        assert_eq!(mesh.euler_characteristic(), 1);
+    }
+}
+
+#[test]
+fn planar_nets_give_planar_patches() {
+    for kind in [IfsKind::Loop, IfsKind::Sqrt3] {
+        // The regular net: both schemes reproduce linear functions, so the
+        // patch is the triangle itself, its vertices the fine lattice.
+        let p = regular_net(kind).expect("net");
+        let k = 3;
+        let mesh = surface(kind, &p, k, None);
+        let side = if kind == IfsKind::Loop { 8 } else { 27 };
+        let want: Vec<DVec3> = (0..=side)
+            .flat_map(|a| (0..=side - a).map(move |b| (a, b)))
+            .map(|(a, b)| lattice_xy([a, b]) / side as f64)
+            .collect();
+        same_vertices(&mesh, &want);
+        // A tilted affine image of the net: every point stays in its plane.
+        let normal = DVec3::new(-0.3, 0.2, 1.0).normalize();
+        let tilted: Vec<DVec3> = p
+            .iter()
+            .map(|x| {
+                let (a, b) = (x.x + 0.4 * x.y, 1.5 * x.y);
+                DVec3::new(a, b, 0.3 * a - 0.2 * b + 1.0)
+            })
+            .collect();
+        let offset = normal.dot(tilted[0]);
+        assert!(offset.abs() > 0.5);
+        let mesh = surface(kind, &tilted, k, None);
+        for x in &mesh.points {
+            assert!(
+                (normal.dot(*x) - offset).abs() < 1e-12,
+                "{kind:?}: {x} off the plane"
+            );
+        }
+    }
+}
+
+#[test]
+fn dropping_maps_keeps_q_to_the_k_pieces_on_the_surface() {
+    let (_, p) = bumpy_net(IfsKind::Loop);
+    let k = 4;
+    let full = surface(IfsKind::Loop, &p, k, None);
+    // The three corner maps: a Sierpinski gasket on the Loop surface, 3^k
+    // triangles on (3^(k+1) + 3)/2 vertices, every one a vertex of the full
+    // mesh (the subset's attractor lies in the full one).
+    let gasket = surface(IfsKind::Loop, &p, k, Some(vec![2, 0, 1]));
+    assert_eq!(gasket.faces.len(), 3usize.pow(k as u32));
+    assert_eq!(gasket.points.len(), (3usize.pow(k as u32 + 1) + 3) / 2);
+    for x in &gasket.points {
+        let d = full
+            .points
+            .iter()
+            .map(|y| y.distance(*x))
+            .fold(f64::INFINITY, f64::min);
+        assert!(d < 1e-12);
+    }
+    let (_, q) = bumpy_net(IfsKind::Sqrt3);
+    for keep in [vec![0, 1, 2, 6, 7, 8], vec![4], vec![0, 8]] {
+        let m = surface(IfsKind::Sqrt3, &q, 2, Some(keep.clone()));
+        assert_eq!(m.faces.len(), keep.len().pow(2), "{keep:?}");
+    }
+    // Koch with its two outer maps: 2^k separate pieces.
+    let IfsShape::Polylines(lines) = ifs_shape(
+        IfsKind::Koch,
+        &koch_control(),
+        k,
+        &IfsOptions {
+            maps: Some(vec![0, 3]),
+            start: IfsStart::Attractor,
+        },
+    )
+    .expect("koch") else {
+        panic!("polylines")
+    };
+    assert_eq!(lines.len(), 1 << k);
+    assert!(lines.iter().all(|l| l.len() == 2));
+    // Bézier with its left map only: one piece, [0, 2^-k].
+    let p3 = [
+        DVec3::ZERO,
+        DVec3::new(1.0, 2.0, 0.0),
+        DVec3::new(3.0, 0.0, 1.0),
+    ];
+    let IfsShape::Polylines(lines) = ifs_shape(
+        IfsKind::Bezier,
+        &p3,
+        k,
+        &IfsOptions {
+            maps: Some(vec![0]),
+            start: IfsStart::Attractor,
+        },
+    )
+    .expect("bezier") else {
+        panic!("polylines")
+    };
+    assert_eq!(lines.len(), 1);
+    assert!(lines[0][1].distance(bernstein_curve(&p3, 1.0 / 16.0)) < 1e-12);
+    // Bad subsets.
+    let ifs = Ifs::new(IfsKind::Loop, &p).expect("ifs");
+    for (keep, msg) in [
+        (vec![0, 4], "map 4 does not exist: Loop has maps 0 to 3"),
+        (vec![1, 1], "map 1 is given twice"),
+        (vec![], "keep at least one map"),
+    ] {
+        assert_eq!(ifs.subset(&keep).unwrap_err().to_string(), msg);
+    }
+}
+
+#[test]
+fn any_start_set_converges_to_the_attractor() {
+    // Bézier from a triangle (its middle corner is off the curve): the
+    // images after k rounds lie within C 2^-k of the curve.
+    let p = [
+        DVec3::ZERO,
+        DVec3::new(1.0, 2.0, 0.0),
+        DVec3::new(2.0, -1.0, 0.5),
+        DVec3::new(3.0, 0.0, 0.0),
+    ];
+    let dist_to_curve = |x: DVec3| {
+        (0..=4096)
+            .map(|j| bernstein_curve(&p, j as f64 / 4096.0).distance(x))
+            .fold(f64::INFINITY, f64::min)
+    };
+    let worst = |k: usize| {
+        let opts = IfsOptions {
+            maps: None,
+            start: IfsStart::Triangle,
+        };
+        let IfsShape::Surface(m) = ifs_shape(IfsKind::Bezier, &p, k, &opts).expect("shape") else {
+            panic!("triangles")
+        };
+        assert_eq!(m.faces.len(), 1 << k);
+        assert_eq!(m.points.len(), 3 << k);
+        m.points
+            .iter()
+            .map(|&x| dist_to_curve(x))
+            .fold(0.0, f64::max)
+    };
+    let (w2, w8) = (worst(2), worst(8));
+    assert!(w2 > 0.05, "{w2}");
+    assert!(w8 < w2 / 30.0 && w8 < 2e-2, "{w2} {w8}");
+    // A point and a segment: q^k points and segments.
+    let opts = IfsOptions {
+        maps: Some(vec![0, 1, 2]),
+        start: IfsStart::Point,
+    };
+    let (_, net) = bumpy_net(IfsKind::Loop);
+    let IfsShape::Points(pts) = ifs_shape(IfsKind::Loop, &net, 3, &opts).expect("points") else {
+        panic!("points")
+    };
+    assert_eq!(pts.len(), 27);
+    let opts = IfsOptions {
+        maps: None,
+        start: IfsStart::Segment,
+    };
+    let IfsShape::Polylines(segs) =
+        ifs_shape(IfsKind::Koch, &koch_control(), 3, &opts).expect("segments")
+    else {
+        panic!("segments")
+    };
+    assert_eq!(segs.len(), 64);
+    // Koch's segment start (0,0)–(1,0) gives the Koch polygon: segments of
+    // length 3^-3.
+    for s in &segs {
+        assert!((s[0].distance(s[1]) - 1.0 / 27.0).abs() < 1e-12);
+    }
+    // A mesh start on the planar Loop net: copies of it, in the plane.
+    let start = PolyMesh::new(
+        vec![
+            DVec3::new(5.0, 1.0, 0.0),
+            DVec3::new(-2.0, 0.0, 0.0),
+            DVec3::new(0.0, 3.0, 0.0),
+            DVec3::new(1.0, 1.0, 0.0),
+        ],
+        vec![vec![0, 1, 2], vec![0, 2, 3]],
+    );
+    let flat = regular_net(IfsKind::Loop).expect("net");
+    let opts = IfsOptions {
+        maps: None,
+        start: IfsStart::Mesh(start),
+    };
+    let IfsShape::Surface(m) = ifs_shape(IfsKind::Loop, &flat, 3, &opts).expect("mesh") else {
+        panic!("surface")
+    };
+    assert_eq!((m.points.len(), m.faces.len()), (4 * 64, 2 * 64));
+    // In the plane of the net, and the copies shrink towards the patch
+    // triangle: the farthest point from its centroid after 3 and 6 rounds.
+    let centre = DVec3::new(0.5, 3f64.sqrt() / 6.0, 0.0);
+    let spread = |m: &PolyMesh| {
+        m.points
+            .iter()
+            .map(|x| x.distance(centre))
+            .fold(0.0, f64::max)
+    };
+    for x in &m.points {
+        assert!(x.z.abs() < 1e-12);
+    }
+    let opts6 = IfsOptions {
+        maps: None,
+        start: opts.start.clone(),
+    };
+    let IfsShape::Surface(m6) = ifs_shape(IfsKind::Loop, &flat, 6, &opts6).expect("mesh") else {
+        panic!("surface")
+    };
+    // The patch triangle's corners are 1/√3 from its centroid.
+    let (s3, s6) = (spread(&m), spread(&m6));
+    assert!(s6 < s3 && s6 < 1.0 / 3f64.sqrt() + 0.1, "{s3} {s6}");
+}
+
+#[test]
+fn new_kinds_refuse_wrong_control_counts() {
+    for (kind, n, msg) in [
+        (
+            IfsKind::Loop,
+            11,
+            "Loop needs exactly 12 control points, got 11",
+        ),
+        (
+            IfsKind::Sqrt3,
+            12,
+            "Sqrt3 needs exactly 27 control points, got 12",
+        ),
+        (
+            IfsKind::Bezier,
+            1,
+            "Bezier needs at least 2 control points, got 1",
+        ),
+        (
+            IfsKind::ClampedCubicBSpline,
+            3,
+            "ClampedCubicBSpline needs at least 4 control points, got 3",
+        ),
+    ] {
+        let err = Ifs::new(kind, &vec![DVec3::ZERO; n]).unwrap_err();
+        assert_eq!(err.to_string(), msg);
+    }
+    let (_, p) = bumpy_net(IfsKind::Sqrt3);
+    assert!(matches!(
+        ifs_shape(IfsKind::Sqrt3, &p, 9, &IfsOptions::default()),
+        Err(SurfaceError::TooLarge { .. })
+    ));
+    let bad_start = IfsOptions {
+        maps: None,
+        start: IfsStart::Mesh(PolyMesh::new(vec![DVec3::ZERO; 3], vec![vec![0, 1, 3]])),
+    };
+    assert_eq!(
+        ifs_shape(IfsKind::Sqrt3, &p, 1, &bad_start).unwrap_err(),
+        SurfaceError::VertexOutOfRange {
+            face: 0,
+            vertex: 3,
+            count: 3
+        }
+    );
+}
+
+#[test]
+fn bicubic_surface_is_a_triangle_mesh_of_patch_points() {
+    let (nu, nv) = (5, 4);
+    let p: Vec<DVec3> = (0..nu * nv)
+        .map(|i| {
+            let (u, v) = ((i / nv) as f64, (i % nv) as f64);
+            DVec3::new(u, v, 0.4 * (u * 0.7).cos() * (v + 1.0).sqrt())
+        })
+        .collect();
+    let k = 3;
+    let mesh = surface(IfsKind::Bicubic { nu, nv }, &p, k, None);
+    let side = (1usize << k) + 1;
+    assert_eq!(mesh.points.len(), side * side);
+    assert_eq!(mesh.faces.len(), 2 * 4usize.pow(k as u32));
+    assert!(mesh.faces.iter().all(|f| f.len() == 3));
+    let want: Vec<DVec3> = (0..side)
+        .flat_map(|i| (0..side).map(move |j| (i, j)))
+        .map(|(i, j)| {
+            let u = (nu - 3) as f64 * i as f64 / (side - 1) as f64;
+            let v = (nv - 3) as f64 * j as f64 / (side - 1) as f64;
+            bicubic_patch(&p, nu, nv, u, v)
+        })
+        .collect();
+    same_vertices(&mesh, &want);
+    assert!(mesh.validate().is_ok());
+    assert_eq!(mesh.euler_characteristic(), 1);
+}
+
+/// Distance in the plane `z = 0` from `x` to the triangle `abc`.
+fn distance_to_triangle(x: DVec3, [a, b, c]: [DVec3; 3]) -> f64 {
+    let cross = |u: DVec3, v: DVec3| u.x * v.y - u.y * v.x;
+    let area = cross(b - a, c - a);
+    let inside = [(a, b), (b, c), (c, a)]
+        .iter()
+        .all(|&(p, q)| cross(q - p, x - p) * area >= 0.0);
+    if inside {
+        return 0.0;
+    }
+    [(a, b), (b, c), (c, a)]
+        .iter()
+        .map(|&(p, q)| {
+            let t = ((x - p).dot(q - p) / (q - p).length_squared()).clamp(0.0, 1.0);
+            x.distance(p + t * (q - p))
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
+#[test]
+fn surface_ifs_from_a_far_mesh_converges_to_the_patch() {
+    // On the regular planar net the patch is the triangle (0,0), (1,0),
+    // (1/2, √3/2) itself; a mesh far outside it is pulled onto it, the
+    // farthest point's distance shrinking by the subdominant factor (1/2 for
+    // Loop per step, 1/3 for √3 per double step) up to constants.
+    let tri = [
+        DVec3::ZERO,
+        DVec3::X,
+        DVec3::new(0.5, 3f64.sqrt() / 2.0, 0.0),
+    ];
+    let far = PolyMesh::new(
+        vec![
+            DVec3::new(6.0, 5.0, 0.0),
+            DVec3::new(9.0, 5.0, 0.0),
+            DVec3::new(7.0, 8.0, 0.0),
+        ],
+        vec![vec![0, 1, 2]],
+    );
+    for (kind, k1, k2, factor) in [(IfsKind::Loop, 3, 7, 16.0), (IfsKind::Sqrt3, 2, 4, 9.0)] {
+        let p = regular_net(kind).expect("net");
+        let worst = |k: usize| {
+            let opts = IfsOptions {
+                maps: None,
+                start: IfsStart::Mesh(far.clone()),
+            };
+            let IfsShape::Surface(m) = ifs_shape(kind, &p, k, &opts).expect("shape") else {
+                panic!("surface")
+            };
+            m.points
+                .iter()
+                .map(|&x| distance_to_triangle(x, tri))
+                .fold(0.0, f64::max)
+        };
+        let (d1, d2) = (worst(k1), worst(k2));
+        assert!(d1 > 1e-3, "{kind:?}: {d1}");
+        assert!(d2 < d1 / factor, "{kind:?}: {d1} then {d2}");
+    }
+}
+
+#[test]
+fn the_nets_are_the_smallest_closed_ones() {
+    // Loop closes on the 12-point net; √3 does not (its rules after two
+    // steps need points at distance 2), and closes on the 27-point net.
+    assert!(
+        lattice::lattice_maps(&lattice::net(1), &lattice::LOOP_SUBS, lattice::loop_fine).is_ok()
+    );
+    assert!(
+        lattice::lattice_maps(&lattice::net(0), &lattice::LOOP_SUBS, lattice::loop_fine).is_err()
+    );
+    assert!(
+        lattice::lattice_maps(&lattice::net(1), &lattice::SQRT3_SUBS, lattice::sqrt3_fine).is_err()
+    );
+    assert!(
+        lattice::lattice_maps(&lattice::net(2), &lattice::SQRT3_SUBS, lattice::sqrt3_fine).is_ok()
+    );
+    // Every map's rows are affine combinations.
+    for kind in [IfsKind::Loop, IfsKind::Sqrt3] {
+        let ifs = Ifs::new(kind, &regular_net(kind).expect("net")).expect("ifs");
+        let m = ifs.dimension();
+        for i in 0..ifs.map_count() {
+            for r in 0..m {
+                let sum: f64 = ifs.map(i)[r * m..(r + 1) * m].iter().sum();
+                assert!((sum - 1.0).abs() < 1e-14, "{kind:?} map {i} row {r}");
+            }
+        }
+    }
 }
