@@ -16,6 +16,10 @@ fn cfg_with(w: Weights) -> WeightedConfig {
     }
 }
 
+fn set(pairs: &[(WeightName, f64)]) -> WeightSet {
+    pairs.iter().copied().collect()
+}
+
 fn face_point(out: &PolyMesh, input: &PolyMesh, f: usize) -> DVec3 {
     // Face points follow the V vertex points and E edge points.
     let e = input.edge_list().len();
@@ -38,10 +42,20 @@ fn zero_weights_give_plain_catmull_clark_bit_for_bit() {
                 sets: vec![AttractorSet {
                     position: [0.2, 0.1, 3.0],
                     strength: 1.0,
-                    weights: zero,
+                    weights: set(&[(WeightName::Edge, 0.0)]),
                 }],
+                mode: Mode::Add,
+                active: None,
             }),
-            axis: None,
+            spherical: Some(SphericalGradient {
+                center: [0.0; 3],
+                stops: vec![Stop {
+                    at: 1.0,
+                    weights: set(&[(WeightName::Vertex, 3.0)]),
+                }],
+                ..Default::default()
+            }),
+            merge_distance: 1e-9,
             vertex_groups: vec![VertexGroup {
                 vertices: vec![1, 2],
                 weights: Some(zero),
@@ -53,6 +67,7 @@ fn zero_weights_give_plain_catmull_clark_bit_for_bit() {
                 weights: zero,
             }],
             locked_edges: vec![],
+            ..Default::default()
         },
     ];
     let creased = Features {
@@ -172,18 +187,18 @@ fn attractor_sets_blend_by_equations_eight_and_nine() {
     // diagonal of the box around the cube and the sets, √11. For the face
     // x = 0 (centroid (0, ½, ½)): d₁ = 1/√11, d₂ = 2/√11, with t = 2, h = 1.
     let mesh = cube();
-    let set = |x: f64, w: f64| AttractorSet {
+    // In "add" mode on a zero base the weight is Σ cₐ wₐ itself.
+    let at = |x: f64, w: f64| AttractorSet {
         position: [x, 0.5, 0.5],
         strength: 1.0,
-        weights: Weights {
-            face_extrude: w,
-            ..Default::default()
-        },
+        weights: set(&[(WeightName::FaceExtrude, w)]),
     };
     let cfg = WeightedConfig {
         attractors: Some(Attractors {
             tightness: 2.0,
-            sets: vec![set(-1.0, 0.2), set(2.0, 0.6)],
+            sets: vec![at(-1.0, 0.2), at(2.0, 0.6)],
+            mode: Mode::Add,
+            active: None,
         }),
         ..Default::default()
     };
@@ -210,15 +225,14 @@ fn axis_gradient_interpolates_between_stops() {
             axis: Axis::Z,
             from: AxisStop {
                 at: 0.0,
-                weights: Weights::default(),
+                weights: WeightSet::new(),
             },
             to: AxisStop {
                 at: 1.0,
-                weights: Weights {
-                    face_extrude: 1.0,
-                    ..Default::default()
-                },
+                weights: set(&[(WeightName::FaceExtrude, 1.0)]),
             },
+            mode: Mode::Add,
+            active: None,
         }),
         ..Default::default()
     };
@@ -365,7 +379,10 @@ fn json_configuration_reads_and_reports_errors_by_line() {
     let cfg = WeightedConfig::from_json_file(&good).unwrap();
     assert_eq!(cfg.iterations[0].face_extrude, 0.25);
     assert_eq!(cfg.mu_by_valence[&3], 0.5);
-    assert_eq!(cfg.attractors.as_ref().unwrap().sets[0].weights.vertex, 0.2);
+    assert_eq!(
+        cfg.attractors.as_ref().unwrap().sets[0].weights[&WeightName::Vertex],
+        0.2
+    );
     assert_eq!(cfg.axis.as_ref().unwrap().axis, Axis::Y);
     assert_eq!(cfg.locked_edges[0].edges, vec![[2, 3]]);
     let out = catmull_clark_weighted(&cube(), 2, &cfg, &Features::default()).unwrap();
