@@ -111,8 +111,10 @@
 //! than d ("a minimum distance beneath which two close vertices are
 //! joined"): in id order each point joins the first earlier kept point
 //! closer than d (so the joined point is where that one was), faces are
-//! renumbered, repeated corners dropped and faces left with fewer than three
-//! corners removed. The joined vertex takes the edges of both, which changes
+//! renumbered, a face that now passes through a point twice is split there
+//! into simple loops (each a face of the same parent and group), and loops
+//! of fewer than three corners are removed; a point no face uses any more
+//! stays in the list, where it was joined. The joined vertex takes the edges of both, which changes
 //! the face/edge motifs of `mu_by_pattern`; if the surface is no longer an
 //! oriented manifold the next iteration stops with the topology error.
 //!
@@ -903,20 +905,29 @@ fn weld(points: &[DVec3], d: f64) -> (Vec<u32>, Vec<u32>) {
     (new_id, kept)
 }
 
-/// `face` renumbered by `new_id`, with repeated neighbours removed; `None`
-/// when fewer than three points remain.
-fn renumber_face(face: &[u32], new_id: &[u32]) -> Option<Vec<u32>> {
-    let mut out: Vec<u32> = Vec::with_capacity(face.len());
+/// `face` renumbered by `new_id` and split into simple loops where it
+/// passes through a point twice; loops of fewer than three corners (repeated
+/// neighbours, slivers) are left out.
+fn renumber_face(face: &[u32], new_id: &[u32]) -> Vec<Vec<u32>> {
+    let mut stack: Vec<u32> = Vec::with_capacity(face.len());
+    let mut loops = Vec::new();
     for &v in face {
         let n = new_id[v as usize];
-        if out.last() != Some(&n) {
-            out.push(n);
+        match stack.iter().position(|&x| x == n) {
+            Some(k) => {
+                let mut l = vec![n];
+                l.extend(stack.drain(k + 1..));
+                if l.len() >= 3 {
+                    loops.push(l);
+                }
+            }
+            None => stack.push(n),
         }
     }
-    while out.len() > 1 && out.first() == out.last() {
-        out.pop();
+    if stack.len() >= 3 {
+        loops.push(stack);
     }
-    (out.len() >= 3).then_some(out)
+    loops
 }
 
 /// Where a point of the current mesh came from.
@@ -1098,7 +1109,7 @@ pub fn catmull_clark_weighted_tracked(
                     let mut keep_faces = Vec::with_capacity(faces.len());
                     let mut renumbered = Vec::with_capacity(faces.len());
                     for (f, face) in faces.iter().enumerate() {
-                        if let Some(nf) = renumber_face(face, &new_id) {
+                        for nf in renumber_face(face, &new_id) {
                             keep_faces.push(f);
                             renumbered.push(nf);
                         }
