@@ -572,12 +572,19 @@ impl WeightedConfig {
                 .and_then(|l| key_before(&text, offset_of(&text, l, e.column())))
                 .map(str::to_string);
             match near {
-                // serde names unknown fields itself; otherwise name the key.
-                Some(k) if !e.to_string().contains("unknown") => IoError::at(
-                    path,
-                    line.unwrap_or(1),
-                    format!("invalid weights file: field `{k}`: {e}"),
-                ),
+                // serde names unknown and missing fields itself; a bad
+                // value (NaN, a string for a number, …) is named here.
+                Some(k)
+                    if !["unknown", "missing field"]
+                        .iter()
+                        .any(|m| e.to_string().contains(m)) =>
+                {
+                    IoError::at(
+                        path,
+                        line.unwrap_or(1),
+                        format!("invalid weights file: field `{k}`: {e}"),
+                    )
+                }
                 _ => IoError::decode(path, line, "invalid weights file", e),
             }
         })?;
