@@ -1120,3 +1120,32 @@ fn bad_weight_files_name_the_file_and_the_field() {
         assert!(e.contains(field), "case {k}: {e}");
     }
 }
+
+#[test]
+fn group_weights_are_a_base_that_the_fields_still_modulate() {
+    // Face group {1} (the top, z = 1) with face_extrude 0.5 as its base; an
+    // axis field in scale mode, factor 1 at z = 0 to 2 at z = 1. The top's
+    // face point moves by 0.5 · 2 = 1 along +z; every other face has base
+    // 0 (no iteration weights), so its face point stays at the centroid.
+    let mesh = cube();
+    let cfg = WeightedConfig {
+        face_groups: vec![FaceGroup {
+            faces: vec![1],
+            weights: extrude(0.5),
+        }],
+        axis: Some(AxisGradient {
+            axis: Axis::Z,
+            from: stop(0.0, &[(WeightName::FaceExtrude, 1.0)]),
+            to: stop(1.0, &[(WeightName::FaceExtrude, 2.0)]),
+            mode: Mode::Scale,
+            active: None,
+        }),
+        ..Default::default()
+    };
+    let out = catmull_clark_weighted(&mesh, 1, &cfg, &Features::default()).unwrap();
+    for f in 0..6 {
+        let c = mesh.face_centroid(f);
+        let expect = if f == 1 { DVec3::new(0.5, 0.5, 2.0) } else { c };
+        assert_eq!(face_point(&out, &mesh, f), expect, "face {f}");
+    }
+}
