@@ -79,7 +79,11 @@
 //! * `attractors`: Σₐ cₐ Wₐ with cₐ = (1 − dₐ)ᵗ hₐ / Σ_b (1 − d_b)ᵗ h_b
 //!   (eqs. 8, 9; t the tightness, hₐ the strength, dₐ ∈ [0, 1] the distance
 //!   divided by the diagonal of the box around the input and the sets);
-//!   no effect where every influence is zero;
+//!   no effect where every influence is zero. As printed, the cₐ sum to 1,
+//!   so a single set gives the same value everywhere; `background` h₀ > 0
+//!   adds a set of neutral weights at distance 0 everywhere (a term h₀ in
+//!   the denominator, h₀/Σ times the neutral value), so that sets fade out
+//!   with distance;
 //! * `axis`: linear between the stops `from` and `to` along x, y or z;
 //! * `radial`: over the distance from the line through `center` along
 //!   `direction`;
@@ -285,6 +289,11 @@ pub struct Attractors {
     pub tightness: f64,
     /// The sets.
     pub sets: Vec<AttractorSet>,
+    /// Strength h₀ of a background set of neutral weights that is at
+    /// distance 0 everywhere (default 0, the paper's eqs. 8, 9): with
+    /// h₀ > 0 a single set no longer gives uniform weights but fades to
+    /// neutral away from its position.
+    pub background: f64,
     /// Scale (default) or add.
     pub mode: Mode,
     /// Iterations `[first, last]` (0-based, inclusive) in which the field
@@ -297,6 +306,7 @@ impl Default for Attractors {
         Attractors {
             tightness: 2.0,
             sets: Vec::new(),
+            background: 0.0,
             mode: Mode::Scale,
             active: None,
         }
@@ -618,6 +628,12 @@ impl WeightedConfig {
                     att.tightness
                 ));
             }
+            if !(att.background.is_finite() && att.background >= 0.0) {
+                return Err(format!(
+                    "field `attractors.background` must be a non-negative number, not {}",
+                    att.background
+                ));
+            }
             for (k, s) in att.sets.iter().enumerate() {
                 if !(s.strength.is_finite() && s.strength >= 0.0) {
                     return Err(format!(
@@ -801,9 +817,9 @@ impl Spatial<'_> {
                     (1.0 - d).powf(att.tightness) * s.strength
                 })
                 .collect();
-            let total: f64 = infl.iter().sum();
+            let total: f64 = infl.iter().sum::<f64>() + att.background;
             if total > 0.0 && total.is_finite() {
-                let mut v = [0.0; NW];
+                let mut v = [att.mode.neutral() * (att.background / total); NW];
                 for (s, c) in att.sets.iter().zip(&infl) {
                     let w = filled(&s.weights, att.mode.neutral());
                     for i in 0..NW {

@@ -44,6 +44,7 @@ fn zero_weights_give_plain_catmull_clark_bit_for_bit() {
                     strength: 1.0,
                     weights: set(&[(WeightName::Edge, 0.0)]),
                 }],
+                background: 0.0,
                 mode: Mode::Add,
                 active: None,
             }),
@@ -197,6 +198,7 @@ fn attractor_sets_blend_by_equations_eight_and_nine() {
         attractors: Some(Attractors {
             tightness: 2.0,
             sets: vec![at(-1.0, 0.2), at(2.0, 0.6)],
+            background: 0.0,
             mode: Mode::Add,
             active: None,
         }),
@@ -1004,6 +1006,7 @@ fn attractor_sets_scale_the_iteration_weights() {
             strength: 1.0,
             weights: set(&[(WeightName::FaceExtrude, 2.0)]),
         }],
+        background: 0.0,
         mode: Mode::Scale,
         active: None,
     });
@@ -1013,6 +1016,25 @@ fn attractor_sets_scale_the_iteration_weights() {
         let got = face_point(&out, &mesh, face);
         assert!(got.distance(c + cube_normal(&mesh, face) * 0.4) < 1e-15);
     }
+    // With a background of strength 1 (neutral factor 1 at distance 0):
+    // distances are divided by the diagonal of the box (0,0,−1)-(1,1,1),
+    // √6. With tightness 1 the set's influence at a face is
+    // c = 1 − |centroid − set|/√6 and eq. 9 with the background gives the
+    // factor (2c + 1·1)/(c + 1).
+    cfg.attractors.as_mut().unwrap().background = 1.0;
+    let out = catmull_clark_weighted(&mesh, 1, &cfg, &Features::default()).unwrap();
+    let set_at = DVec3::new(0.5, 0.5, -1.0);
+    let mut factors = Vec::new();
+    for face in 0..6 {
+        let c = mesh.face_centroid(face);
+        let infl = 1.0 - c.distance(set_at) / 6f64.sqrt();
+        let factor = (2.0 * infl + 1.0) / (infl + 1.0);
+        factors.push(factor);
+        let got = face_point(&out, &mesh, face);
+        assert!(got.distance(c + cube_normal(&mesh, face) * 0.2 * factor) < 1e-15);
+    }
+    // The bottom (nearest) is pulled most, the top least.
+    assert!(factors[0] > factors[2] && factors[2] > factors[1]);
 }
 
 #[test]
