@@ -55,7 +55,9 @@
 //! * the **fields**, each with `"mode": "scale"` (the default) or `"add"`,
 //!   and optionally `"active": [first, last]` (the iterations, inclusive, in
 //!   which it acts): `attractors` (eqs. 8, 9), `axis`, `radial`,
-//!   `spherical`, `edge_distance`, `vertex_distance` and `planarity`. A
+//!   `spherical`, `edge_distance`, `vertex_distance` and `planarity`, each
+//!   given as one object or a list of them (several gradients of one kind,
+//!   say with different `active` iterations, which then compose too). A
 //!   field's weight sets are partial: a set names only the weights it
 //!   changes, the others get the mode's neutral value (factor 1, offset 0),
 //!   so a set leaves them alone.
@@ -457,19 +459,26 @@ pub struct WeightedConfig {
     /// `mu_by_valence`.
     pub mu_by_pattern: BTreeMap<String, f64>,
     /// Weight sets placed in space (eqs. 8, 9).
-    pub attractors: Option<Attractors>,
+    #[serde(deserialize_with = "one_or_many")]
+    pub attractors: Vec<Attractors>,
     /// A linear gradient along an axis.
-    pub axis: Option<AxisGradient>,
+    #[serde(deserialize_with = "one_or_many")]
+    pub axis: Vec<AxisGradient>,
     /// A radial gradient (distance from a line).
-    pub radial: Option<RadialGradient>,
+    #[serde(deserialize_with = "one_or_many")]
+    pub radial: Vec<RadialGradient>,
     /// A spherical gradient (distance from a point).
-    pub spherical: Option<SphericalGradient>,
+    #[serde(deserialize_with = "one_or_many")]
+    pub spherical: Vec<SphericalGradient>,
     /// A gradient over the distance to the nearest edge of the input.
-    pub edge_distance: Option<Ramp>,
+    #[serde(deserialize_with = "one_or_many")]
+    pub edge_distance: Vec<Ramp>,
     /// A gradient over the distance to the nearest vertex of the input.
-    pub vertex_distance: Option<Ramp>,
+    #[serde(deserialize_with = "one_or_many")]
+    pub vertex_distance: Vec<Ramp>,
     /// A gradient over the scaled planarity (module docs).
-    pub planarity: Option<Ramp>,
+    #[serde(deserialize_with = "one_or_many")]
+    pub planarity: Vec<Ramp>,
     /// Points of a step closer than this are joined into one (0: never).
     pub merge_distance: f64,
     /// Vertex groups.
@@ -478,6 +487,34 @@ pub struct WeightedConfig {
     pub face_groups: Vec<FaceGroup>,
     /// Locked edges.
     pub locked_edges: Vec<LockedEdges>,
+}
+
+/// Reads one object or a list of them (a field given once, or several
+/// times, each with its own `active` iterations).
+fn one_or_many<'de, D, T>(d: D) -> Result<Vec<T>, D::Error>
+where
+    D: serde::Deserializer<'de>,
+    T: Deserialize<'de>,
+{
+    use serde::de::value::{MapAccessDeserializer, SeqAccessDeserializer};
+    use serde::de::{MapAccess, SeqAccess, Visitor};
+    struct OneOrMany<T>(std::marker::PhantomData<T>);
+    impl<'de, T: Deserialize<'de>> Visitor<'de> for OneOrMany<T> {
+        type Value = Vec<T>;
+        fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+            f.write_str("an object, a list of objects or null")
+        }
+        fn visit_unit<E: serde::de::Error>(self) -> Result<Vec<T>, E> {
+            Ok(Vec::new())
+        }
+        fn visit_map<A: MapAccess<'de>>(self, map: A) -> Result<Vec<T>, A::Error> {
+            T::deserialize(MapAccessDeserializer::new(map)).map(|t| vec![t])
+        }
+        fn visit_seq<A: SeqAccess<'de>>(self, seq: A) -> Result<Vec<T>, A::Error> {
+            Vec::<T>::deserialize(SeqAccessDeserializer::new(seq))
+        }
+    }
+    d.deserialize_any(OneOrMany(std::marker::PhantomData))
 }
 
 /// Byte offset of (1-based) `line`, `column` in `text`.
@@ -500,6 +537,21 @@ fn key_before(text: &str, end: usize) -> Option<&str> {
     let close = before.strip_suffix('"')?;
     let open = close.rfind('"')?;
     Some(&close[open + 1..])
+}
+
+/// `field.sub` for a field given once, `field[n].sub` for one of a list
+/// (`sub` empty: the field itself).
+fn field_name(field: &str, n: usize, count: usize, sub: &str) -> String {
+    let head = if count > 1 {
+        format!("{field}[{n}]")
+    } else {
+        field.to_string()
+    };
+    if sub.is_empty() {
+        head
+    } else {
+        format!("{head}.{sub}")
+    }
 }
 
 fn check_finite(what: &str, x: f64) -> Result<(), String> {
@@ -621,66 +673,74 @@ impl WeightedConfig {
             }
             check_finite(&format!("mu_by_pattern.{key}"), mu)?;
         }
-        if let Some(att) = &self.attractors {
+        for (n, att) in self.attractors.iter().enumerate() {
+            let at = |f: &str| field_name("attractors", n, self.attractors.len(), f);
             if !(att.tightness.is_finite() && att.tightness > 0.0) {
                 return Err(format!(
-                    "field `attractors.tightness` must be a positive number, not {}",
+                    "field `{}` must be a positive number, not {}",
+                    at("tightness"),
                     att.tightness
                 ));
             }
             if !(att.background.is_finite() && att.background >= 0.0) {
                 return Err(format!(
-                    "field `attractors.background` must be a non-negative number, not {}",
+                    "field `{}` must be a non-negative number, not {}",
+                    at("background"),
                     att.background
                 ));
             }
             for (k, s) in att.sets.iter().enumerate() {
                 if !(s.strength.is_finite() && s.strength >= 0.0) {
                     return Err(format!(
-                        "field `attractors.sets[{k}].strength` must be a non-negative number, not {}",
+                        "field `{}` must be a non-negative number, not {}",
+                        at(&format!("sets[{k}].strength")),
                         s.strength
                     ));
                 }
                 for (j, &x) in s.position.iter().enumerate() {
-                    check_finite(&format!("attractors.sets[{k}].position[{j}]"), x)?;
+                    check_finite(&at(&format!("sets[{k}].position[{j}]")), x)?;
                 }
-                check_set(&format!("attractors.sets[{k}].weights"), &s.weights)?;
+                check_set(&at(&format!("sets[{k}].weights")), &s.weights)?;
             }
-            check_active("attractors", att.active)?;
+            check_active(&at(""), att.active)?;
         }
-        if let Some(ax) = &self.axis {
-            check_finite("axis.from.at", ax.from.at)?;
-            check_finite("axis.to.at", ax.to.at)?;
-            check_set("axis.from.weights", &ax.from.weights)?;
-            check_set("axis.to.weights", &ax.to.weights)?;
-            check_active("axis", ax.active)?;
+        for (n, ax) in self.axis.iter().enumerate() {
+            let at = |f: &str| field_name("axis", n, self.axis.len(), f);
+            check_finite(&at("from.at"), ax.from.at)?;
+            check_finite(&at("to.at"), ax.to.at)?;
+            check_set(&at("from.weights"), &ax.from.weights)?;
+            check_set(&at("to.weights"), &ax.to.weights)?;
+            check_active(&at(""), ax.active)?;
         }
-        if let Some(r) = &self.radial {
+        for (n, r) in self.radial.iter().enumerate() {
+            let at = |f: &str| field_name("radial", n, self.radial.len(), f);
             for (j, &x) in r.center.iter().chain(&r.direction).enumerate() {
                 let f = if j < 3 { "center" } else { "direction" };
-                check_finite(&format!("radial.{f}[{}]", j % 3), x)?;
+                check_finite(&at(&format!("{f}[{}]", j % 3)), x)?;
             }
             if DVec3::from_array(r.direction).length_squared() == 0.0 {
-                return Err("field `radial.direction` must not be zero".into());
+                return Err(format!("field `{}` must not be zero", at("direction")));
             }
-            check_stops("radial", &r.stops)?;
-            check_active("radial", r.active)?;
+            check_stops(&at(""), &r.stops)?;
+            check_active(&at(""), r.active)?;
         }
-        if let Some(s) = &self.spherical {
+        for (n, s) in self.spherical.iter().enumerate() {
+            let at = |f: &str| field_name("spherical", n, self.spherical.len(), f);
             for (j, &x) in s.center.iter().enumerate() {
-                check_finite(&format!("spherical.center[{j}]"), x)?;
+                check_finite(&at(&format!("center[{j}]")), x)?;
             }
-            check_stops("spherical", &s.stops)?;
-            check_active("spherical", s.active)?;
+            check_stops(&at(""), &s.stops)?;
+            check_active(&at(""), s.active)?;
         }
-        for (name, ramp) in [
+        for (name, ramps) in [
             ("edge_distance", &self.edge_distance),
             ("vertex_distance", &self.vertex_distance),
             ("planarity", &self.planarity),
         ] {
-            if let Some(r) = ramp {
-                check_stops(name, &r.stops)?;
-                check_active(name, r.active)?;
+            for (n, r) in ramps.iter().enumerate() {
+                let at = field_name(name, n, ramps.len(), "");
+                check_stops(&at, &r.stops)?;
+                check_active(&at, r.active)?;
             }
         }
         if !(self.merge_distance.is_finite() && self.merge_distance >= 0.0) {
@@ -712,14 +772,14 @@ impl WeightedConfig {
     fn any_field(&self, k: usize) -> bool {
         let on = |a: Option<[usize; 2]>| a.is_none_or(|[f, l]| f <= k && k <= l);
         self.attractors
-            .as_ref()
-            .is_some_and(|a| !a.sets.is_empty() && on(a.active))
-            || self.axis.as_ref().is_some_and(|a| on(a.active))
-            || self.radial.as_ref().is_some_and(|a| on(a.active))
-            || self.spherical.as_ref().is_some_and(|a| on(a.active))
+            .iter()
+            .any(|a| !a.sets.is_empty() && on(a.active))
+            || self.axis.iter().any(|a| on(a.active))
+            || self.radial.iter().any(|a| on(a.active))
+            || self.spherical.iter().any(|a| on(a.active))
             || [&self.edge_distance, &self.vertex_distance, &self.planarity]
                 .iter()
-                .any(|r| r.as_ref().is_some_and(|r| on(r.active)))
+                .any(|r| r.iter().any(|r| on(r.active)))
     }
 }
 
@@ -808,7 +868,7 @@ impl Spatial<'_> {
         };
         let pos = place.pos;
         let cfg = self.cfg;
-        if let Some(att) = cfg.attractors.as_ref().filter(|a| on(a.active)) {
+        for att in cfg.attractors.iter().filter(|a| on(a.active)) {
             let infl: Vec<f64> = att
                 .sets
                 .iter()
@@ -829,7 +889,7 @@ impl Spatial<'_> {
                 apply(att.mode, v);
             }
         }
-        if let Some(ax) = cfg.axis.as_ref().filter(|a| on(a.active)) {
+        for ax in cfg.axis.iter().filter(|a| on(a.active)) {
             let x = match ax.axis {
                 Axis::X => pos.x,
                 Axis::Y => pos.y,
@@ -852,18 +912,18 @@ impl Spatial<'_> {
                 std::array::from_fn(|i| va[i] * (1.0 - t) + vb[i] * t),
             );
         }
-        if let Some(r) = cfg.radial.as_ref().filter(|a| on(a.active)) {
+        for r in cfg.radial.iter().filter(|a| on(a.active)) {
             let c = DVec3::from_array(r.center);
             let d = DVec3::from_array(r.direction).normalize();
             let rel = pos - c;
             let dist = (rel - d * rel.dot(d)).length();
             apply(r.mode, ramp_at(&r.stops, dist, r.mode.neutral()));
         }
-        if let Some(s) = cfg.spherical.as_ref().filter(|a| on(a.active)) {
+        for s in cfg.spherical.iter().filter(|a| on(a.active)) {
             let dist = pos.distance(DVec3::from_array(s.center));
             apply(s.mode, ramp_at(&s.stops, dist, s.mode.neutral()));
         }
-        if let Some(r) = cfg.edge_distance.as_ref().filter(|a| on(a.active)) {
+        for r in cfg.edge_distance.iter().filter(|a| on(a.active)) {
             let dist = self
                 .input_edges
                 .iter()
@@ -871,7 +931,7 @@ impl Spatial<'_> {
                 .fold(f64::INFINITY, f64::min);
             apply(r.mode, ramp_at(&r.stops, dist, r.mode.neutral()));
         }
-        if let Some(r) = cfg.vertex_distance.as_ref().filter(|a| on(a.active)) {
+        for r in cfg.vertex_distance.iter().filter(|a| on(a.active)) {
             let dist = self
                 .input_points
                 .iter()
@@ -879,7 +939,7 @@ impl Spatial<'_> {
                 .fold(f64::INFINITY, f64::min);
             apply(r.mode, ramp_at(&r.stops, dist, r.mode.neutral()));
         }
-        if let Some(r) = cfg.planarity.as_ref().filter(|a| on(a.active)) {
+        for r in cfg.planarity.iter().filter(|a| on(a.active)) {
             apply(r.mode, ramp_at(&r.stops, place.planarity, r.mode.neutral()));
         }
         let b = base.to_array();
@@ -1026,7 +1086,7 @@ pub fn catmull_clark_weighted_tracked(
     // Distance scale: the diagonal of the box around the input and the sets.
     let mut scale = 1.0;
     if let Some((mut lo, mut hi)) = mesh.bounding_box() {
-        if let Some(att) = &cfg.attractors {
+        for att in &cfg.attractors {
             for s in &att.sets {
                 lo = lo.min(DVec3::from_array(s.position));
                 hi = hi.max(DVec3::from_array(s.position));
@@ -1229,7 +1289,7 @@ impl StepContext<'_> {
             })
             .collect();
         // Scaled planarity of the faces, when a field uses it.
-        let planarity: Vec<f64> = if self.cfg.planarity.is_some() {
+        let planarity: Vec<f64> = if !self.cfg.planarity.is_empty() {
             (0..mesh.faces.len())
                 .into_par_iter()
                 .map(|f| face_planarity(mesh, f))

@@ -37,7 +37,7 @@ fn zero_weights_give_plain_catmull_clark_bit_for_bit() {
             iterations: vec![zero, zero],
             mu_by_valence: [(3, 1.0), (4, -0.5)].into_iter().collect(),
             mu_by_pattern: [("3F3E".to_string(), 2.0)].into_iter().collect(),
-            attractors: Some(Attractors {
+            attractors: vec![Attractors {
                 tightness: 2.0,
                 sets: vec![AttractorSet {
                     position: [0.2, 0.1, 3.0],
@@ -47,15 +47,15 @@ fn zero_weights_give_plain_catmull_clark_bit_for_bit() {
                 background: 0.0,
                 mode: Mode::Add,
                 active: None,
-            }),
-            spherical: Some(SphericalGradient {
+            }],
+            spherical: vec![SphericalGradient {
                 center: [0.0; 3],
                 stops: vec![Stop {
                     at: 1.0,
                     weights: set(&[(WeightName::Vertex, 3.0)]),
                 }],
                 ..Default::default()
-            }),
+            }],
             merge_distance: 1e-9,
             vertex_groups: vec![VertexGroup {
                 vertices: vec![1, 2],
@@ -195,13 +195,13 @@ fn attractor_sets_blend_by_equations_eight_and_nine() {
         weights: set(&[(WeightName::FaceExtrude, w)]),
     };
     let cfg = WeightedConfig {
-        attractors: Some(Attractors {
+        attractors: vec![Attractors {
             tightness: 2.0,
             sets: vec![at(-1.0, 0.2), at(2.0, 0.6)],
             background: 0.0,
             mode: Mode::Add,
             active: None,
-        }),
+        }],
         ..Default::default()
     };
     let out = catmull_clark_weighted(&mesh, 1, &cfg, &Features::default()).unwrap();
@@ -223,7 +223,7 @@ fn axis_gradient_interpolates_between_stops() {
     // sides (centroid z = ½) 0.5, the top 1.
     let mesh = cube();
     let cfg = WeightedConfig {
-        axis: Some(AxisGradient {
+        axis: vec![AxisGradient {
             axis: Axis::Z,
             from: AxisStop {
                 at: 0.0,
@@ -235,7 +235,7 @@ fn axis_gradient_interpolates_between_stops() {
             },
             mode: Mode::Add,
             active: None,
-        }),
+        }],
         ..Default::default()
     };
     let out = catmull_clark_weighted(&mesh, 1, &cfg, &Features::default()).unwrap();
@@ -381,11 +381,8 @@ fn json_configuration_reads_and_reports_errors_by_line() {
     let cfg = WeightedConfig::from_json_file(&good).unwrap();
     assert_eq!(cfg.iterations[0].face_extrude, 0.25);
     assert_eq!(cfg.mu_by_valence[&3], 0.5);
-    assert_eq!(
-        cfg.attractors.as_ref().unwrap().sets[0].weights[&WeightName::Vertex],
-        0.2
-    );
-    assert_eq!(cfg.axis.as_ref().unwrap().axis, Axis::Y);
+    assert_eq!(cfg.attractors[0].sets[0].weights[&WeightName::Vertex], 0.2);
+    assert_eq!(cfg.axis[0].axis, Axis::Y);
     assert_eq!(cfg.locked_edges[0].edges, vec![[2, 3]]);
     let out = catmull_clark_weighted(&cube(), 2, &cfg, &Features::default()).unwrap();
     out.validate().unwrap();
@@ -691,19 +688,19 @@ fn spatial_fields_modulate_the_iteration_weights_instead_of_replacing_them() {
         face_extrude: 0.2,
         ..Default::default()
     });
-    cfg.axis = Some(AxisGradient {
+    cfg.axis = vec![AxisGradient {
         axis: Axis::Z,
         from: stop(0.0, &[(WeightName::FaceExtrude, 1.0)]),
         to: stop(1.0, &[(WeightName::FaceExtrude, 3.0)]),
         mode: Mode::Scale,
         active: None,
-    });
-    cfg.spherical = Some(SphericalGradient {
+    }];
+    cfg.spherical = vec![SphericalGradient {
         center: [0.5; 3],
         stops: vec![stop(0.0, &[(WeightName::FaceExtrude, 0.1)])],
         mode: Mode::Add,
         active: None,
-    });
+    }];
     let f = Features::default();
     let out = catmull_clark_weighted(&mesh, 1, &cfg, &f).unwrap();
     for face in 0..6 {
@@ -721,13 +718,13 @@ fn spatial_fields_modulate_the_iteration_weights_instead_of_replacing_them() {
         vertex: 1.0,
         ..Default::default()
     });
-    cfg.axis = Some(AxisGradient {
+    cfg.axis = vec![AxisGradient {
         axis: Axis::X,
         from: stop(0.0, &[(WeightName::EdgeExtrude, 5.0)]),
         to: stop(1.0, &[(WeightName::EdgeExtrude, 5.0)]),
         mode: Mode::Scale,
         active: None,
-    });
+    }];
     let out = catmull_clark_weighted(&mesh, 1, &cfg, &f).unwrap();
     assert!(out.points[0].distance(DVec3::splat(5.0 / 18.0)) < 1e-15);
     // Per-iteration weights and fields together: iteration weights 0.2 then
@@ -739,13 +736,13 @@ fn spatial_fields_modulate_the_iteration_weights_instead_of_replacing_them() {
         iterations: vec![extrude(0.2), extrude(0.0)],
         ..Default::default()
     };
-    cfg.radial = Some(RadialGradient {
+    cfg.radial = vec![RadialGradient {
         center: [0.0; 3],
         direction: [0.0, 0.0, 1.0],
         stops: vec![stop(0.0, &[(WeightName::FaceExtrude, 3.0)])],
         mode: Mode::Scale,
         active: Some([0, 0]),
-    });
+    }];
     let one = catmull_clark_weighted(&mesh, 1, &cfg, &f).unwrap();
     for face in 0..6 {
         let c = mesh.face_centroid(face);
@@ -753,12 +750,12 @@ fn spatial_fields_modulate_the_iteration_weights_instead_of_replacing_them() {
         assert!(got.distance(c + cube_normal(&mesh, face) * 0.6) < 1e-15);
     }
     let two_without = catmull_clark_weighted(&mesh, 2, &cfg, &f).unwrap();
-    cfg.spherical = Some(SphericalGradient {
+    cfg.spherical = vec![SphericalGradient {
         center: [0.5; 3],
         stops: vec![stop(0.0, &[(WeightName::FaceExtrude, 0.3)])],
         mode: Mode::Add,
         active: Some([1, 1]),
-    });
+    }];
     assert_eq!(catmull_clark_weighted(&mesh, 1, &cfg, &f).unwrap(), one);
     let two_with = catmull_clark_weighted(&mesh, 2, &cfg, &f).unwrap();
     assert_ne!(two_with, two_without);
@@ -798,7 +795,7 @@ fn spherical_gradient_changes_only_the_faces_near_its_centre() {
     let f = Features::default();
     let mut cfg = base(extrude(0.2));
     let plain = catmull_clark_weighted(&mesh, 1, &cfg, &f).unwrap();
-    cfg.spherical = Some(SphericalGradient {
+    cfg.spherical = vec![SphericalGradient {
         center: [0.5, 0.5, -0.5],
         stops: vec![
             stop(0.5, &[(WeightName::FaceExtrude, 3.0)]),
@@ -806,13 +803,13 @@ fn spherical_gradient_changes_only_the_faces_near_its_centre() {
         ],
         mode: Mode::Scale,
         active: None,
-    });
+    }];
     let out = catmull_clark_weighted(&mesh, 1, &cfg, &f).unwrap();
     let bottom = 0; // [0, 2, 3, 1], z = 0
     only_faces_changed(&mesh, &out, &plain, &[bottom]);
     assert!(face_point(&out, &mesh, bottom).distance(DVec3::new(0.5, 0.5, -0.6)) < 1e-15);
     // Midway between the stops the factor is 2.
-    cfg.spherical.as_mut().unwrap().center = [0.5, 0.5, -0.75];
+    cfg.spherical[0].center = [0.5, 0.5, -0.75];
     let out = catmull_clark_weighted(&mesh, 1, &cfg, &f).unwrap();
     assert!(face_point(&out, &mesh, bottom).distance(DVec3::new(0.5, 0.5, -0.4)) < 1e-15);
 }
@@ -828,7 +825,7 @@ fn radial_gradient_depends_on_the_distance_from_its_line_only() {
     let f = Features::default();
     let mut cfg = base(extrude(0.2));
     let plain = catmull_clark_weighted(&mesh, 1, &cfg, &f).unwrap();
-    cfg.radial = Some(RadialGradient {
+    cfg.radial = vec![RadialGradient {
         center: [0.0, 0.0, 7.0],
         direction: [0.0, 0.0, -2.0],
         stops: vec![
@@ -837,7 +834,7 @@ fn radial_gradient_depends_on_the_distance_from_its_line_only() {
         ],
         mode: Mode::Scale,
         active: None,
-    });
+    }];
     let out = catmull_clark_weighted(&mesh, 1, &cfg, &f).unwrap();
     only_faces_changed(&mesh, &out, &plain, &[2, 4]);
     assert!(face_point(&out, &mesh, 4).distance(DVec3::new(-0.6, 0.5, 0.5)) < 1e-15);
@@ -903,14 +900,14 @@ fn distance_to_the_input_vertices_weights_the_points_by_it() {
     let plain = lifted_points(&vertex_extrude_in_second_step(w));
     check_lifted(&plain, w, |_, _| 1.0);
     let mut cfg = vertex_extrude_in_second_step(w);
-    cfg.vertex_distance = Some(Ramp {
+    cfg.vertex_distance = vec![Ramp {
         stops: vec![
             stop(0.0, &[(WeightName::VertexExtrude, 0.0)]),
             stop(0.5, &[(WeightName::VertexExtrude, 1.0)]),
             stop(1.0, &[(WeightName::VertexExtrude, 3.0)]),
         ],
         ..Default::default()
-    });
+    }];
     let centre = 1.0 + 2.0 * (2f64.sqrt() / 2.0 - 0.5) / 0.5;
     check_lifted(&lifted_points(&cfg), w, |x, y| {
         match (x.fract() == 0.0, y.fract() == 0.0) {
@@ -928,13 +925,13 @@ fn distance_to_the_input_edges_weights_the_points_by_it() {
     // the centres change, to three times the plain lift.
     let w = 0.4;
     let mut cfg = vertex_extrude_in_second_step(w);
-    cfg.edge_distance = Some(Ramp {
+    cfg.edge_distance = vec![Ramp {
         stops: vec![
             stop(0.0, &[(WeightName::VertexExtrude, 1.0)]),
             stop(0.5, &[(WeightName::VertexExtrude, 3.0)]),
         ],
         ..Default::default()
-    });
+    }];
     check_lifted(&lifted_points(&cfg), w, |x, y| {
         if x.fract() != 0.0 && y.fract() != 0.0 {
             3.0
@@ -967,13 +964,13 @@ fn planarity_weights_follow_the_papers_measure() {
     assert!(p > 0.0 && p < 0.1);
     let factor = 1.0 + 2.0 * p / 0.1;
     let mut cfg = base(extrude(0.2));
-    cfg.planarity = Some(Ramp {
+    cfg.planarity = vec![Ramp {
         stops: vec![
             stop(0.0, &[(WeightName::FaceExtrude, 1.0)]),
             stop(0.1, &[(WeightName::FaceExtrude, 3.0)]),
         ],
         ..Default::default()
-    });
+    }];
     let out = catmull_clark_weighted(&quad, 1, &cfg, &Features::default()).unwrap();
     let area = DVec3::new(-h, -h, 2.0) * 0.5;
     let expect =
@@ -999,7 +996,7 @@ fn attractor_sets_scale_the_iteration_weights() {
     // influence is positive: face_extrude 0.2 → 0.4 on every face.
     let mesh = cube();
     let mut cfg = base(extrude(0.2));
-    cfg.attractors = Some(Attractors {
+    cfg.attractors = vec![Attractors {
         tightness: 1.0,
         sets: vec![AttractorSet {
             position: [0.5, 0.5, -1.0],
@@ -1009,7 +1006,7 @@ fn attractor_sets_scale_the_iteration_weights() {
         background: 0.0,
         mode: Mode::Scale,
         active: None,
-    });
+    }];
     let out = catmull_clark_weighted(&mesh, 1, &cfg, &Features::default()).unwrap();
     for face in 0..6 {
         let c = mesh.face_centroid(face);
@@ -1021,7 +1018,7 @@ fn attractor_sets_scale_the_iteration_weights() {
     // √6. With tightness 1 the set's influence at a face is
     // c = 1 − |centroid − set|/√6 and eq. 9 with the background gives the
     // factor (2c + 1·1)/(c + 1).
-    cfg.attractors.as_mut().unwrap().background = 1.0;
+    cfg.attractors[0].background = 1.0;
     let out = catmull_clark_weighted(&mesh, 1, &cfg, &Features::default()).unwrap();
     let set_at = DVec3::new(0.5, 0.5, -1.0);
     let mut factors = Vec::new();
@@ -1155,13 +1152,13 @@ fn group_weights_are_a_base_that_the_fields_still_modulate() {
             faces: vec![1],
             weights: extrude(0.5),
         }],
-        axis: Some(AxisGradient {
+        axis: vec![AxisGradient {
             axis: Axis::Z,
             from: stop(0.0, &[(WeightName::FaceExtrude, 1.0)]),
             to: stop(1.0, &[(WeightName::FaceExtrude, 2.0)]),
             mode: Mode::Scale,
             active: None,
-        }),
+        }],
         ..Default::default()
     };
     let out = catmull_clark_weighted(&mesh, 1, &cfg, &Features::default()).unwrap();
@@ -1170,4 +1167,56 @@ fn group_weights_are_a_base_that_the_fields_still_modulate() {
         let expect = if f == 1 { DVec3::new(0.5, 0.5, 2.0) } else { c };
         assert_eq!(face_point(&out, &mesh, f), expect, "face {f}");
     }
+}
+
+#[test]
+fn a_field_may_be_given_once_or_as_a_list() {
+    // Two spherical fields (constant factors 2 and 3 in scale mode) multiply:
+    // face_extrude 0.1 → 0.6 in iteration 0; the second acts only from
+    // iteration 1 on, so with "active": [1, 1] the first step has 0.2.
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("w.json");
+    let text = |active: &str| {
+        format!(
+            r#"{{ "iterations": [ {{ "face_extrude": 0.1 }} ],
+  "spherical": [
+    {{ "stops": [ {{ "at": 0, "weights": {{ "face_extrude": 2 }} }} ] }},
+    {{ "stops": [ {{ "at": 0, "weights": {{ "face_extrude": 3 }} }} ]{active} }} ],
+  "axis": null }}"#
+        )
+    };
+    let mesh = cube();
+    for (active, w) in [("", 0.6), (r#", "active": [1, 1]"#, 0.2)] {
+        std::fs::write(&path, text(active)).unwrap();
+        let cfg = WeightedConfig::from_json_file(&path).unwrap();
+        assert_eq!(cfg.spherical.len(), 2);
+        assert!(cfg.axis.is_empty());
+        let out = catmull_clark_weighted(&mesh, 1, &cfg, &Features::default()).unwrap();
+        for f in 0..6 {
+            let c = mesh.face_centroid(f);
+            let got = face_point(&out, &mesh, f);
+            assert!(
+                got.distance(c + cube_normal(&mesh, f) * w) < 1e-15,
+                "{active}"
+            );
+        }
+    }
+    // One object is a list of one; an error in a list names the entry.
+    std::fs::write(&path, r#"{ "planarity": { "stops": [ { "at": 0 } ] } }"#).unwrap();
+    assert_eq!(
+        WeightedConfig::from_json_file(&path)
+            .unwrap()
+            .planarity
+            .len(),
+        1
+    );
+    std::fs::write(
+        &path,
+        r#"{ "planarity": [ { "stops": [ { "at": 0 } ] }, { "stops": [ { "at": 0 } ], "active": [3, 2] } ] }"#,
+    )
+    .unwrap();
+    let e = WeightedConfig::from_json_file(&path)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("`planarity[1].active`"), "{e}");
 }
