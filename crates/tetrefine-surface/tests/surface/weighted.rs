@@ -1220,3 +1220,67 @@ fn a_field_may_be_given_once_or_as_a_list() {
         .to_string();
     assert!(e.contains("`planarity[1].active`"), "{e}");
 }
+
+#[test]
+fn a_merge_that_pinches_the_surface_stops_the_next_step_with_an_error() {
+    // The locked pillow of `merge_distance_joins_coincident_points`: the
+    // joined centre has the four quads of each side around it, two fans
+    // meeting in one point, which is no manifold; the second step refuses
+    // it with the topology error instead of panicking.
+    let pillow = PolyMesh::new(
+        vec![DVec3::ZERO, DVec3::X, DVec3::new(1.0, 1.0, 0.0), DVec3::Y],
+        vec![vec![0, 1, 2, 3], vec![0, 3, 2, 1]],
+    );
+    let cfg = WeightedConfig {
+        merge_distance: 1e-6,
+        vertex_groups: vec![VertexGroup {
+            vertices: vec![0, 1, 2, 3],
+            weights: None,
+            lock_iterations: 1,
+            lock_start: 0,
+        }],
+        ..Default::default()
+    };
+    let f = Features::default();
+    assert!(catmull_clark_weighted(&pillow, 1, &cfg, &f).is_ok());
+    let e = catmull_clark_weighted(&pillow, 2, &cfg, &f).unwrap_err();
+    assert!(
+        matches!(e, tetrefine_surface::SubdivisionError::Topology(_)),
+        "{e}"
+    );
+}
+
+#[test]
+fn vertex_group_weights_are_a_base_that_the_fields_still_modulate() {
+    // Vertex 0 of the cube, (0,0,0), with its own vertex weight 0.5 and a
+    // spherical field doubling `vertex` within ½ of the origin (factor 2
+    // at 0.5, 1 from 0.6 on; the other corners are ≥ 1 away): eq. 3 with
+    // w_v = 1 there, (5/18)(1,1,1); every other vertex point is plain.
+    let mesh = cube();
+    let cfg = WeightedConfig {
+        vertex_groups: vec![VertexGroup {
+            vertices: vec![0],
+            weights: Some(Weights {
+                vertex: 0.5,
+                ..Default::default()
+            }),
+            lock_iterations: 0,
+            lock_start: 0,
+        }],
+        spherical: vec![SphericalGradient {
+            center: [0.0; 3],
+            stops: vec![
+                stop(0.5, &[(WeightName::Vertex, 2.0)]),
+                stop(0.6, &[(WeightName::Vertex, 1.0)]),
+            ],
+            mode: Mode::Scale,
+            active: None,
+        }],
+        ..Default::default()
+    };
+    let f = Features::default();
+    let out = catmull_clark_weighted(&mesh, 1, &cfg, &f).unwrap();
+    let plain = catmull_clark(&mesh, 1, &f).unwrap();
+    assert!(out.points[0].distance(DVec3::splat(5.0 / 18.0)) < 1e-15);
+    assert_eq!(out.points[1..], plain.points[1..]);
+}
