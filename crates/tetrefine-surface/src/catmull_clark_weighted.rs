@@ -1119,7 +1119,7 @@ pub fn catmull_clark_weighted_tracked(
     let group_id = |g: Option<usize>| g.map_or(0, |g| g as u32 + 1);
     let mut attributes = FaceAttributes::input(mesh.faces.len());
     attributes.group = face_group.iter().map(|&g| group_id(g)).collect();
-    run_steps(
+    let done = run_steps(
         mesh,
         he0,
         creases,
@@ -1232,7 +1232,14 @@ pub fn catmull_clark_weighted_tracked(
                 group,
             }
         },
-    )
+    )?;
+    // Finite weights can still overflow (an extrusion of 1e300, many steps).
+    if let Some(p) = done.mesh.points.iter().find(|p| !p.is_finite()) {
+        return Err(SubdivisionError::BadParameter(format!(
+            "the weights drive the points out of range (a point at {p}); use smaller weights or fewer steps"
+        )));
+    }
+    Ok(done)
 }
 
 struct StepContext<'a> {

@@ -1112,4 +1112,23 @@ fn bad_weight_files_fail_cleanly() {
         fails_cleanly(&args, field, &out);
         fails_cleanly(&args, s(&w), &out);
     }
+    // Finite weights whose result overflows: refused, nothing written.
+    let w = dir.path().join("huge.json");
+    std::fs::write(
+        &w,
+        r#"{ "iterations": [ { "face_extrude": 1e300, "edge": 1e308 } ] }"#,
+    )
+    .unwrap();
+    let args = [
+        "surface",
+        "catmull-clark-weighted",
+        s(&quad),
+        "-o",
+        s(&out),
+        "--steps",
+        "3",
+        "--weights",
+        s(&w),
+    ];
+    fails_cleanly(&args, "out of range", &out);
 }
