@@ -100,6 +100,9 @@
 //!   its two faces, a vertex that of the faces around it.
 //!
 //! Distances are in model units (attractors excepted, as in the paper).
+//! The distances to the input's edges and vertices are found by looking at
+//! every one of them, which suits the small control meshes the paper starts
+//! from (platonic solids), not inputs of many thousands of edges.
 //!
 //! # Locks and merging
 //!
