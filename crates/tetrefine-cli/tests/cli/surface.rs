@@ -1212,3 +1212,199 @@ fn sierpinski_output_fed_back_goes_on_as_one_run() {
         &lines,
     );
 }
+
+/// The block of kind `kind` (```` ```kind ````) after byte `from` of `text`.
+fn block_after<'a>(text: &'a str, from: usize, kind: &str) -> (&'a str, usize) {
+    let open = format!("```{kind}\n");
+    let start = from + text[from..].find(&open).expect(&open) + open.len();
+    let len = text[start..].find("```").expect("closing fence");
+    (&text[start..start + len], start + len)
+}
+
+/// Every path to a member of an object in `v` (at any depth).
+fn member_paths(
+    v: &serde_json::Value,
+    path: &mut Vec<serde_json::Value>,
+    out: &mut Vec<Vec<serde_json::Value>>,
+) {
+    match v {
+        serde_json::Value::Object(m) => {
+            for (k, x) in m {
+                path.push(k.clone().into());
+                out.push(path.clone());
+                member_paths(x, path, out);
+                path.pop();
+            }
+        }
+        serde_json::Value::Array(a) => {
+            for (i, x) in a.iter().enumerate() {
+                path.push(i.into());
+                member_paths(x, path, out);
+                path.pop();
+            }
+        }
+        _ => {}
+    }
+}
+
+/// `v` without the member at `path`.
+fn without(v: &serde_json::Value, path: &[serde_json::Value]) -> serde_json::Value {
+    let mut v = v.clone();
+    let mut node = &mut v;
+    for step in &path[..path.len() - 1] {
+        node = match step {
+            serde_json::Value::String(k) => node.get_mut(k.as_str()).unwrap(),
+            serde_json::Value::Number(i) => node.get_mut(i.as_u64().unwrap() as usize).unwrap(),
+            _ => unreachable!(),
+        };
+    }
+    let key = path.last().unwrap().as_str().unwrap();
+    assert!(node.as_object_mut().unwrap().remove(key).is_some());
+    v
+}
+
+#[test]
+fn readme_weighted_example_every_setting_matters() {
+    // The README's cube.obj, w.json and command, run as written; then each
+    // member of w.json removed in turn must change out.obj, or (for the
+    // settings that cannot be left out) be refused naming the member, with
+    // nothing written.
+    let readme = std::fs::read_to_string(crate::support::path("README.md")).unwrap();
+    let at = readme
+        .find("Example: the unit cube `cube.obj`")
+        .expect("README example");
+    let (cube_obj, end) = block_after(&readme, at, "text");
+    let (json, end) = block_after(&readme, end, "json");
+    let (cmd, _) = block_after(&readme, end, "sh");
+    let args: Vec<&str> = cmd
+        .trim()
+        .strip_prefix("tetrefine ")
+        .expect("a tetrefine command")
+        .split_whitespace()
+        .collect();
+    assert_eq!(args[..2], ["surface", "catmull-clark-weighted"]);
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("cube.obj"), cube_obj).unwrap();
+    // The README's cube is the unit cube of the shapes module.
+    assert_eq!(load_surface(&dir.path().join("cube.obj")).unwrap(), cube());
+    let run_with = |cfg: &str| {
+        std::fs::write(dir.path().join("w.json"), cfg).unwrap();
+        let out = dir.path().join("out.obj");
+        let _ = std::fs::remove_file(&out);
+        let o = crate::tetrefine_command()
+            .args(&args)
+            .current_dir(dir.path())
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&o.stderr).into_owned();
+        match o.status.success() {
+            true => Ok(std::fs::read(&out).unwrap()),
+            false => {
+                assert!(!out.exists(), "{err}");
+                Err(err)
+            }
+        }
+    };
+    let full = run_with(json).expect("the README example runs");
+    // Plain Catmull–Clark differs too (the file is not a no-op).
+    assert_ne!(Ok(full.clone()), run_with("{}"));
+    let value: serde_json::Value = serde_json::from_str(json).unwrap();
+    let mut paths = Vec::new();
+    member_paths(&value, &mut Vec::new(), &mut paths);
+    assert!(paths.len() > 60, "{}", paths.len());
+    let required = ["axis.axis", "axis.from", "axis.to", "radial.direction"];
+    let mut refused = 0;
+    for path in &paths {
+        let name: Vec<String> = path
+            .iter()
+            .map(|p| match p {
+                serde_json::Value::String(s) => s.clone(),
+                other => other.to_string(),
+            })
+            .collect();
+        let name = name.join(".");
+        let cfg = serde_json::to_string_pretty(&without(&value, path)).unwrap();
+        match run_with(&cfg) {
+            Ok(out) => assert_ne!(out, full, "removing {name} changes nothing"),
+            Err(err) => {
+                let key = path.last().unwrap().as_str().unwrap();
+                let allowed = required.contains(&name.as_str())
+                    || key == "stops"
+                    || (key == "at" && !name.ends_with(".0.at"));
+                assert!(allowed, "removing {name} is refused: {err}");
+                assert!(
+                    err.contains(&format!("`{key}`")) || err.contains(&format!(".{key}`")),
+                    "{name}: {err}"
+                );
+                assert_eq!(err.trim().lines().count(), 1, "{err}");
+                refused += 1;
+            }
+        }
+    }
+    assert!(
+        refused < paths.len() / 4,
+        "{refused} of {} refused",
+        paths.len()
+    );
+}
+
+#[test]
+fn bad_weight_files_fail_cleanly() {
+    let dir = tempfile::tempdir().unwrap();
+    let quad = dir.path().join("cube.obj");
+    write_surface(&quad, &cube()).unwrap();
+    let out = dir.path().join("out.obj");
+    let cases = [
+        (
+            r#"{ "spherical": { "center": [0, 0, 0], "radius": 1 } }"#,
+            "radius",
+        ),
+        (
+            "{\n  \"iterations\": [ { \"vertex\": NaN } ]\n}",
+            "`vertex`",
+        ),
+        (
+            r#"{ "attractors": { "tightness": -2 } }"#,
+            "attractors.tightness",
+        ),
+        (
+            r#"{ "edge_distance": { "stops": [ { "at": 1 }, { "at": 1 } ] } }"#,
+            "edge_distance.stops[1].at",
+        ),
+        (r#"{ "merge_distance": -1 }"#, "merge_distance"),
+    ];
+    for (k, (text, field)) in cases.iter().enumerate() {
+        let w = dir.path().join(format!("w{k}.json"));
+        std::fs::write(&w, text).unwrap();
+        let args = [
+            "surface",
+            "catmull-clark-weighted",
+            s(&quad),
+            "-o",
+            s(&out),
+            "--weights",
+            s(&w),
+        ];
+        fails_cleanly(&args, field, &out);
+        fails_cleanly(&args, s(&w), &out);
+    }
+    // Finite weights whose result overflows: refused, nothing written.
+    let w = dir.path().join("huge.json");
+    std::fs::write(
+        &w,
+        r#"{ "iterations": [ { "face_extrude": 1e300, "edge": 1e308 } ] }"#,
+    )
+    .unwrap();
+    let args = [
+        "surface",
+        "catmull-clark-weighted",
+        s(&quad),
+        "-o",
+        s(&out),
+        "--steps",
+        "3",
+        "--weights",
+        s(&w),
+    ];
+    fails_cleanly(&args, "out of range", &out);
+}
