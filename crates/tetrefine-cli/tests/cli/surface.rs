@@ -6,12 +6,10 @@ use glam::DVec3;
 use std::path::Path;
 use tetrefine_surface::{load_surface, write_surface};
 
+/// [`crate::run`] as (success, stderr): what these tests look at.
 fn run(args: &[&str]) -> (bool, String) {
-    let out = crate::tetrefine_command().args(args).output().unwrap();
-    (
-        out.status.success(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
+    let out = crate::run(args);
+    (out.status.success(), crate::stderr(&out))
 }
 
 fn s(p: &Path) -> &str {
