@@ -227,18 +227,6 @@ impl ClosedTopology {
     }
 }
 
-fn tetrahedron() -> tetrefine_surface::PolyMesh {
-    tetrefine_surface::PolyMesh::new(
-        vec![
-            DVec3::new(1.0, 1.0, 1.0),
-            DVec3::new(1.0, -1.0, -1.0),
-            DVec3::new(-1.0, 1.0, -1.0),
-            DVec3::new(-1.0, -1.0, 1.0),
-        ],
-        vec![vec![0, 1, 2], vec![0, 3, 1], vec![0, 2, 3], vec![1, 3, 2]],
-    )
-}
-
 #[test]
 fn sierpinski_writes_one_closed_surface_of_the_stated_genus() {
     let dir = tempfile::tempdir().unwrap();

@@ -28,18 +28,6 @@ fn histogram(values: &[u32]) -> Vec<usize> {
     h
 }
 
-fn tetrahedron() -> PolyMesh {
-    PolyMesh::new(
-        vec![
-            DVec3::new(1.0, 1.0, 1.0),
-            DVec3::new(1.0, -1.0, -1.0),
-            DVec3::new(-1.0, 1.0, -1.0),
-            DVec3::new(-1.0, -1.0, 1.0),
-        ],
-        vec![vec![0, 1, 2], vec![0, 3, 1], vec![0, 2, 3], vec![1, 3, 2]],
-    )
-}
-
 #[test]
 fn loop_children_keep_their_parents_corner_and_count_4_to_the_k() {
     let ico = icosahedron();

@@ -182,3 +182,16 @@ pub fn icosahedron() -> PolyMesh {
     .collect();
     PolyMesh::new(p, f)
 }
+
+/// The regular tetrahedron inscribed in the cube [-1, 1]³, outward faces.
+pub fn tetrahedron() -> PolyMesh {
+    PolyMesh::new(
+        vec![
+            DVec3::new(1.0, 1.0, 1.0),
+            DVec3::new(1.0, -1.0, -1.0),
+            DVec3::new(-1.0, 1.0, -1.0),
+            DVec3::new(-1.0, -1.0, 1.0),
+        ],
+        vec![vec![0, 1, 2], vec![0, 3, 1], vec![0, 2, 3], vec![1, 3, 2]],
+    )
+}
