@@ -159,6 +159,7 @@ class Mesh:
         hmax: float | None = None,
         effort: str = "default",
         hausd: float | None = None,
+        interfaces: Literal["linear", "sqrt3"] = "linear",
     ) -> Mesh: ...
     def improve(
         self,
