@@ -69,7 +69,8 @@ pub struct BoundarySmoothOptions {
     /// Flip boundary edges where it raises the worst tet of their ring and
     /// the surface stays within the Hausdorff bound
     /// ([`crate::ops::flip_boundary_edge`]; exactly coplanar faces only when
-    /// `crease_angle` is [`FLAT_ONLY`]).
+    /// `crease_angle` allows flat stars only, 1e-4° or less, as the linear
+    /// rule sets it).
     pub flip_edges: bool,
 }
 
