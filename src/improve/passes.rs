@@ -293,13 +293,13 @@ fn boundary_flip_pass(
             if !mesh.is_boundary_face(t, f) {
                 continue;
             }
+            let p = mesh.tet_points(t);
             for (e, [i, j]) in TET_EDGES.iter().enumerate() {
                 if *i == f || *j == f {
                     continue;
                 }
                 // The face's third corner: local ids sum to 0+1+2+3 = 6.
                 let k = 6 - f - i - j;
-                let p = mesh.tet_points(t);
                 let mean_edge =
                     (p[*i].distance(p[*j]) + p[*i].distance(p[k]) + p[*j].distance(p[k])) / 3.0;
                 let limits = BoundaryFlipLimits {

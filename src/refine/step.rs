@@ -87,13 +87,13 @@ struct StepState {
     first_face_point: u32,
     /// Old boundary faces that were split, outward-oriented, with their new point.
     split_faces: Vec<([u32; 3], u32)>,
-    /// Old interface faces (between regions, or marked) that were split, with
-    /// their new point.
-    split_interfaces: Vec<([u32; 3], u32)>,
-    /// Those of `split_interfaces` that lie between two regions, oriented
-    /// outward from the lower region (one orientation per interface patch,
-    /// as the √3 stencils need).
+    /// Old interface faces between two regions that were split, with their
+    /// new point, oriented outward from the lower region (one orientation per
+    /// interface patch, as the √3 stencils need).
     region_interfaces: Vec<([u32; 3], u32)>,
+    /// Old marked faces inside one region that were split, with their new
+    /// point (always refined linearly).
+    marked_interfaces: Vec<([u32; 3], u32)>,
     /// 1-based step number: feature edges are kept in odd steps and trisected
     /// in even ones.
     step: usize,
@@ -122,8 +122,8 @@ pub fn refine_step_with_progress(
         first_barycentre: mesh.n_points() as u32,
         first_face_point: u32::MAX,
         split_faces: Vec::new(),
-        split_interfaces: Vec::new(),
         region_interfaces: Vec::new(),
+        marked_interfaces: Vec::new(),
         step: step + opts.step_offset,
         creases: mesh.feature_edges().keys().copied().collect(),
         trisected: HashSet::new(),
@@ -311,8 +311,9 @@ fn boundary_split_phase(mesh: &mut TetMesh, st: &mut StepState, report: &mut Ste
         let c = (p[0] + p[1] + p[2]) / 3.0;
         let (rt, ru) = (mesh.region(t), mesh.region(mesh.adj(t)[f] >> 2));
         if let Ok(m) = split_interface_face(mesh, t, f, c) {
-            st.split_interfaces.push((fv, m));
-            if rt != ru {
+            if rt == ru {
+                st.marked_interfaces.push((fv, m));
+            } else {
                 // `fv` is seen from `t`, outward: reversed when `t` is on the
                 // higher side.
                 let oriented = if rt < ru { fv } else { [fv[0], fv[2], fv[1]] };
@@ -411,7 +412,8 @@ fn boundary_flip_phase(
     // Old edges seen from the split faces, with how often and one face point.
     let mut seen: FastHashMap<[u32; 2], (u32, u8)> =
         FastHashMap::with_capacity_and_hasher(3 * st.split_faces.len() / 2, Default::default());
-    for &(f, m) in st.split_faces.iter().chain(&st.split_interfaces) {
+    let split = st.split_faces.iter().chain(&st.region_interfaces);
+    for &(f, m) in split.chain(&st.marked_interfaces) {
         for i in 0..3 {
             let k = edge_key(f[i], f[(i + 1) % 3]);
             seen.entry(k).and_modify(|e| e.1 += 1).or_insert((m, 1));
@@ -589,25 +591,24 @@ fn boundary_smooth_phase(
         pinned.insert(e[0]);
         pinned.insert(e[1]);
     }
+    // Marked faces inside one region always stay linear; interfaces between
+    // regions too, unless `--interfaces sqrt3`.
+    let linear_regions: &[([u32; 3], u32)] = if sqrt3_interfaces {
+        &[]
+    } else {
+        &st.region_interfaces
+    };
+    for (f, m) in st.marked_interfaces.iter().chain(linear_regions) {
+        pinned.extend(f.iter().copied());
+        pinned.insert(*m);
+    }
     if sqrt3_interfaces {
-        // Marked faces inside one region stay linear; a point on both the
-        // boundary and an interface (a junction even where no feature is
-        // tagged, `--features none`) would get two targets.
-        let smooth: HashSet<u32> = st.region_interfaces.iter().map(|(_, m)| *m).collect();
-        for (f, m) in &st.split_interfaces {
-            if !smooth.contains(m) {
-                pinned.extend(f.iter().copied());
-                pinned.insert(*m);
-            }
-        }
+        // A point on both the boundary and an interface (a junction even
+        // where no feature is tagged, `--features none`) would get two
+        // targets.
         let on_boundary: HashSet<u32> = st.split_faces.iter().flat_map(|(f, _)| *f).collect();
         for (f, _) in &st.region_interfaces {
             pinned.extend(f.iter().filter(|v| on_boundary.contains(v)));
-        }
-    } else {
-        for (f, m) in &st.split_interfaces {
-            pinned.extend(f.iter().copied());
-            pinned.insert(*m);
         }
     }
     let mut targets = stencil_targets(mesh, &st.split_faces, st, opts, &corners);
