@@ -42,6 +42,8 @@
 // polylines and TetGen are leaves. What a user needs is re-exported below
 // or through the public facade modules (`geom`, `io`, `ops`, `report`,
 // `stencil`, `topo`, `tetgen`), whose own submodules stay private.
+#[cfg(feature = "mpi")]
+pub mod distributed;
 mod file;
 pub mod geom;
 mod improve;
@@ -61,6 +63,9 @@ pub use file::IoError;
 pub use improve::{improve, BoundarySmoothOptions, Effort, ImproveOptions, ImproveReport};
 pub use io::{load_mesh, read_mesh, write_mesh};
 pub use mesh::generate::cube_grid;
+pub use mesh::partition::{
+    canonical_centroid, is_partition_marker, partition_marker, PartitionMarker,
+};
 pub use mesh::{
     ball_stays_positive, BuildReport, CheckError, MeshData, MeshError, Remap, TetMesh, Where, DEAD,
     NO_ADJ,

@@ -301,7 +301,12 @@ impl BoundarySmoother {
             if fs.is_empty() {
                 continue;
             }
-            kind[v as usize] = if mesh.is_corner(v) || mesh.is_required(v) {
+            // A partition face is frozen: the rank on its other side must
+            // see the same points.
+            let on_cut = fs
+                .iter()
+                .any(|&f| crate::mesh::partition::is_partition_marker(keys[f as usize].0));
+            kind[v as usize] = if mesh.is_corner(v) || mesh.is_required(v) || on_cut {
                 Kind::Fixed
             } else if let Some(nb) = line_nbrs.get(&v) {
                 // Under the linear rule (flat stars only) a line vertex stays:

@@ -21,6 +21,7 @@ mod data;
 pub mod fasthash;
 pub mod generate;
 mod moves;
+pub mod partition;
 mod reorder;
 
 /// The store's keys of sparse tags (defined once, in [`crate::topo`]).

@@ -92,6 +92,12 @@ pub fn boundary_flip_ring(
     if mesh.face_marker([a, b, p0]) != mesh.face_marker([a, b, pm]) {
         return Err(OpError::NotApplicable("faces of two markers"));
     }
+    if mesh
+        .face_marker([a, b, p0])
+        .is_some_and(crate::mesh::partition::is_partition_marker)
+    {
+        return Err(OpError::NotApplicable("a partition face must stay"));
+    }
     for i in 1..m {
         let (t0, t1) = (ring.tets[i - 1], ring.tets[i]);
         if mesh.face_is_constrained(t0, Some(t1), [a, b, ring.verts[i]]) {

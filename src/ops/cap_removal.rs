@@ -65,6 +65,12 @@ pub fn remove_boundary_cap(mesh: &mut TetMesh, t: u32, limits: CapLimits) -> Res
     if mesh.face_marker(mesh.face_vertices(t, i)) != mesh.face_marker(mesh.face_vertices(t, j)) {
         return Err(OpError::NotApplicable("boundary faces of two markers"));
     }
+    if mesh
+        .face_marker(mesh.face_vertices(t, i))
+        .is_some_and(crate::mesh::partition::is_partition_marker)
+    {
+        return Err(OpError::NotApplicable("a partition face must stay"));
+    }
     for f in [k, l] {
         if mesh.face_is_constrained(t, Some(adj[f] >> 2), mesh.face_vertices(t, f)) {
             return Err(OpError::NotApplicable("an interior face is constrained"));

@@ -4,6 +4,7 @@ use super::{InterfaceRule, NoProgress, Phase, PhaseReport, Progress, RefineOptio
 use crate::improve::{improve, ImproveOptions};
 use crate::mesh::ball_stays_positive;
 use crate::mesh::fasthash::FastHashMap;
+use crate::mesh::partition::{canonical_centroid, is_partition_marker, PartitionMarker};
 use crate::mesh::{edge_key, TetMarks, TetMesh};
 use crate::ops::{
     flip23_bulk, make_flips_valid, remove_edge, remove_interface_edge, split14_bulk,
@@ -94,6 +95,12 @@ struct StepState {
     /// Old marked faces inside one region that were split, with their new
     /// point (always refined linearly).
     marked_interfaces: Vec<([u32; 3], u32)>,
+    /// Old partition faces ([`crate::mesh::partition`]) that were split, with
+    /// their new point: linear, never flipped, never moved.
+    partition_faces: Vec<([u32; 3], u32)>,
+    /// Edges of every old partition face, split or not: never flipped nor
+    /// trisected (the other side of the cut could not follow).
+    partition_edges: HashSet<[u32; 2]>,
     /// 1-based step number: feature edges are kept in odd steps and trisected
     /// in even ones.
     step: usize,
@@ -124,6 +131,8 @@ pub fn refine_step_with_progress(
         split_faces: Vec::new(),
         region_interfaces: Vec::new(),
         marked_interfaces: Vec::new(),
+        partition_faces: Vec::new(),
+        partition_edges: partition_edges(mesh),
         step: step + opts.step_offset,
         creases: mesh.feature_edges().keys().copied().collect(),
         trisected: HashSet::new(),
@@ -147,53 +156,7 @@ pub fn refine_step_with_progress(
                 // The topological phases appended tets and points at the ends
                 // of the arrays; bring neighbours together in memory first.
                 mesh.reorder_spatially_in_place();
-                if opts.opt_passes > 0 {
-                    let (movable, tet_allowed) = smoothing_zone(mesh, step, opts);
-                    let mut io = ImproveOptions {
-                        movable,
-                        tet_allowed,
-                        ..opts
-                            .effort
-                            .improve_options(opts.opt_passes, opts.threshold, opts.hausd)
-                    };
-                    if matches!(opts.boundary, crate::stencil::Sqrt3Rule::Linear) {
-                        // The linear rule promises the input's domain: a
-                        // boundary vertex moves only inside a flat star, so
-                        // no crease, however shallow, is cut.
-                        if let Some(b) = &mut io.boundary {
-                            b.crease_angle = crate::improve::boundary_smooth::FLAT_ONLY;
-                            b.remove_caps = false;
-                        }
-                    }
-                    // Long edges are split once the passes have evened out the
-                    // step's new points (split on the raw √3 mesh they gain
-                    // half as much: tripod 41.6° against 43.4° average), then
-                    // a second round of passes, with edge removal up to a
-                    // higher bar, settles the new balls.
-                    report.improve = improve(mesh, &io);
-                    if let Some(factor) = opts.effort.long_edge_factor() {
-                        // The first passes created and removed tets: the
-                        // zone is gathered again.
-                        let (movable, tet_allowed) = smoothing_zone(mesh, step, opts);
-                        let io = ImproveOptions {
-                            movable,
-                            tet_allowed,
-                            long_edge_factor: Some(factor),
-                            // Only edges of this step's tets: an adaptive
-                            // step leaves the rest of the mesh at its size.
-                            long_edge_zone: Some(descendants_of_last_step(mesh, step)),
-                            edge_threshold: io.edge_threshold.max(SETTLE_EDGE_THRESHOLD),
-                            // The boundary stays where the first passes left
-                            // it, so `--hausd` bounds the whole step's drift
-                            // (moving it again would measure from the moved
-                            // surface); this costs 0.1°–0.2° of average.
-                            boundary: None,
-                            ..io
-                        };
-                        let second = improve(mesh, &io);
-                        report.improve.add(&second);
-                    }
-                }
+                report.improve = optimize_phase(mesh, step, opts, true);
             }
         }
         progress.phase_end();
@@ -212,6 +175,69 @@ pub fn refine_step_with_progress(
         }
     }
     report.seconds = start.elapsed().as_secs_f64();
+    report
+}
+
+/// Phase 6: edge removal and smoothing, then (at the efforts that have it)
+/// the long-edge round and its settling passes, over the zone
+/// `--smooth` allows. Also run, without the long-edge round
+/// (`long_edges`), by the distributed driver once the cut has moved, so
+/// that the band frozen along it is improved too without splitting the
+/// rest of the mesh a second time.
+pub(crate) fn optimize_phase(
+    mesh: &mut TetMesh,
+    step: usize,
+    opts: &RefineOptions,
+    long_edges: bool,
+) -> crate::improve::ImproveReport {
+    if opts.opt_passes == 0 {
+        return crate::improve::ImproveReport::default();
+    }
+    let (movable, tet_allowed) = smoothing_zone(mesh, step, opts);
+    let mut io = ImproveOptions {
+        movable,
+        tet_allowed,
+        ..opts
+            .effort
+            .improve_options(opts.opt_passes, opts.threshold, opts.hausd)
+    };
+    if matches!(opts.boundary, crate::stencil::Sqrt3Rule::Linear) {
+        // The linear rule promises the input's domain: a
+        // boundary vertex moves only inside a flat star, so
+        // no crease, however shallow, is cut.
+        if let Some(b) = &mut io.boundary {
+            b.crease_angle = crate::improve::boundary_smooth::FLAT_ONLY;
+            b.remove_caps = false;
+        }
+    }
+    // Long edges are split once the passes have evened out the
+    // step's new points (split on the raw √3 mesh they gain
+    // half as much: tripod 41.6° against 43.4° average), then
+    // a second round of passes, with edge removal up to a
+    // higher bar, settles the new balls.
+    let mut report = improve(mesh, &io);
+    if let Some(factor) = opts.effort.long_edge_factor().filter(|_| long_edges) {
+        // The first passes created and removed tets: the
+        // zone is gathered again.
+        let (movable, tet_allowed) = smoothing_zone(mesh, step, opts);
+        let io = ImproveOptions {
+            movable,
+            tet_allowed,
+            long_edge_factor: Some(factor),
+            // Only edges of this step's tets: an adaptive
+            // step leaves the rest of the mesh at its size.
+            long_edge_zone: Some(descendants_of_last_step(mesh, step)),
+            edge_threshold: io.edge_threshold.max(SETTLE_EDGE_THRESHOLD),
+            // The boundary stays where the first passes left
+            // it, so `--hausd` bounds the whole step's drift
+            // (moving it again would measure from the moved
+            // surface); this costs 0.1°–0.2° of average.
+            boundary: None,
+            ..io
+        };
+        let second = improve(mesh, &io);
+        report.add(&second);
+    }
     report
 }
 
@@ -271,9 +297,33 @@ fn flip_phase(mesh: &mut TetMesh, st: &StepState, report: &mut StepReport) {
     report.refused_flips += n - flipped;
 }
 
+/// The edges of every partition face of `mesh` (none when no marker is a
+/// partition marker).
+fn partition_edges(mesh: &TetMesh) -> HashSet<[u32; 2]> {
+    mesh.face_markers()
+        .iter()
+        .filter(|(_, &m)| is_partition_marker(m))
+        .flat_map(|(f, _)| {
+            [
+                edge_key(f[0], f[1]),
+                edge_key(f[1], f[2]),
+                edge_key(f[0], f[2]),
+            ]
+        })
+        .collect()
+}
+
+/// The partition marker of face `fv`, if it has one.
+fn partition_of(mesh: &TetMesh, fv: [u32; 3]) -> Option<PartitionMarker> {
+    if mesh.face_markers().is_empty() {
+        return None;
+    }
+    mesh.face_marker(fv).and_then(PartitionMarker::decode)
+}
+
 /// Phase 3: 1-3 split of every boundary face of a split tet at its
 /// barycentre, and the 2-6 split of every interface face whose two tets were
-/// split.
+/// split. Partition faces are split at their canonical centroid unless held.
 fn boundary_split_phase(mesh: &mut TetMesh, st: &mut StepState, report: &mut StepReport) {
     let first = st.first_barycentre;
     st.first_face_point = mesh.n_points() as u32;
@@ -299,19 +349,41 @@ fn boundary_split_phase(mesh: &mut TetMesh, st: &mut StepState, report: &mut Ste
     for (t, f) in faces {
         let fv = mesh.face_vertices(t, f);
         let p = fv.map(|x| mesh.point(x));
-        let c = (p[0] + p[1] + p[2]) / 3.0;
+        let partition = partition_of(mesh, fv);
+        if partition.is_some_and(|pm| pm.hold) {
+            continue;
+        }
+        let c = match partition {
+            Some(_) => canonical_centroid(p),
+            None => (p[0] + p[1] + p[2]) / 3.0,
+        };
         if let Ok((m, _)) = split_boundary_face(mesh, t, f, c) {
-            st.split_faces.push((fv, m));
+            if partition.is_some() {
+                st.partition_faces.push((fv, m));
+            } else {
+                st.split_faces.push((fv, m));
+            }
             report.boundary_split += 1;
         }
     }
     for (t, f) in interfaces {
         let fv = mesh.face_vertices(t, f);
         let p = fv.map(|x| mesh.point(x));
-        let c = (p[0] + p[1] + p[2]) / 3.0;
+        let partition = partition_of(mesh, fv);
+        if partition.is_some_and(|pm| pm.hold) {
+            continue;
+        }
+        let c = match partition {
+            Some(_) => canonical_centroid(p),
+            None => (p[0] + p[1] + p[2]) / 3.0,
+        };
         let (rt, ru) = (mesh.region(t), mesh.region(mesh.adj(t)[f] >> 2));
         if let Ok(m) = split_interface_face(mesh, t, f, c) {
-            if rt == ru {
+            if partition.is_some() {
+                // A serial run with the cut marked: the step the two ranks
+                // do together, one 1-3 split each.
+                st.partition_faces.push((fv, m));
+            } else if rt == ru {
                 st.marked_interfaces.push((fv, m));
             } else {
                 // `fv` is seen from `t`, outward: reversed when `t` is on the
@@ -430,6 +502,11 @@ fn boundary_flip_phase(
     }
     let mut ring = EdgeRing::default();
     for ([a, b], m) in edges {
+        if st.partition_edges.contains(&[a, b]) {
+            // Both sides of a cut would have to flip together.
+            report.refused_boundary_flips += 1;
+            continue;
+        }
         let is_feature = mesh.is_feature_edge(a, b);
         if is_feature && !even {
             report.kept_feature_edges += 1;
@@ -520,7 +597,7 @@ fn trisect_interior_features(
     let mut edges: Vec<[u32; 2]> = mesh
         .feature_edges()
         .keys()
-        .filter(|k| !on_constrained_faces.contains_key(*k))
+        .filter(|k| !on_constrained_faces.contains_key(*k) && !st.partition_edges.contains(*k))
         .copied()
         .collect();
     edges.sort_unstable();
@@ -598,10 +675,17 @@ fn boundary_smooth_phase(
     } else {
         &st.region_interfaces
     };
-    for (f, m) in st.marked_interfaces.iter().chain(linear_regions) {
+    for (f, m) in st
+        .marked_interfaces
+        .iter()
+        .chain(linear_regions)
+        .chain(&st.partition_faces)
+    {
         pinned.extend(f.iter().copied());
         pinned.insert(*m);
     }
+    // Every point of a partition face, split or held.
+    pinned.extend(st.partition_edges.iter().flatten().copied());
     if sqrt3_interfaces {
         // A point on both the boundary and an interface (a junction even
         // where no feature is tagged, `--features none`) would get two

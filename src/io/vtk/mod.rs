@@ -37,7 +37,7 @@ pub use read::{
     read_noted, read_tet_cell_array, read_with_meta_noted, TetCellArray, DERIVED_CELL_ARRAYS,
     DERIVED_POINT_ARRAYS,
 };
-pub use write::{write_vtu, write_vtu_with, CellArray, PointArray, VtuSummary};
+pub use write::{write_pvtu, write_vtu, write_vtu_with, CellArray, PointArray, VtuSummary};
 
 /// VTK's cell type of a linear tetrahedron.
 const VTK_TETRA: u8 = 10;

@@ -415,3 +415,78 @@ pub fn write_vtu_with(
         )
     })
 }
+
+/// Writes the `.pvtu` (VTK's parallel unstructured grid) that lists the
+/// `.vtu` pieces `pieces` (paths relative to the `.pvtu`'s folder, as
+/// ParaView resolves them), each written by [`write_vtu_with`] with the same
+/// `summary` presence and extra arrays: the declared arrays follow the same
+/// constants as the pieces', so ParaView's `vtkXMLPUnstructuredGridReader`
+/// finds every array it is told of.
+pub fn write_pvtu(
+    path: &Path,
+    pieces: &[String],
+    summary: bool,
+    extra_cells: &[CellArray],
+    extra_points: &[PointArray],
+) -> Result<(), IoError> {
+    if pieces.is_empty() {
+        return Err(IoError::file(path, "a .pvtu needs at least one piece"));
+    }
+    let decl = |ty: &str, name: &str, c: usize| {
+        let comps = if c > 1 {
+            format!(" NumberOfComponents=\"{c}\"")
+        } else {
+            String::new()
+        };
+        format!(
+            "      <PDataArray type=\"{ty}\" Name=\"{}\"{comps}/>",
+            xml_escape(name)
+        )
+    };
+    write_atomic(path, |w| {
+        writeln!(w, "<?xml version=\"1.0\"?>")?;
+        writeln!(
+            w,
+            "<VTKFile type=\"PUnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">"
+        )?;
+        writeln!(w, "  <!-- written by tetrefine -->")?;
+        writeln!(w, "  <PUnstructuredGrid GhostLevel=\"0\">")?;
+        if summary || !extra_points.is_empty() {
+            writeln!(w, "    <PPointData>")?;
+            if summary {
+                writeln!(w, "{}", decl(<i32 as LeBytes>::TYPE, "valence", 1))?;
+            }
+            for a in extra_points {
+                let line = match a {
+                    PointArray::Float64(n, c, _) => decl(<f64 as LeBytes>::TYPE, n, *c),
+                    PointArray::Int32(n, c, _) => decl(<i32 as LeBytes>::TYPE, n, *c),
+                };
+                writeln!(w, "{line}")?;
+            }
+            writeln!(w, "    </PPointData>")?;
+        }
+        writeln!(w, "    <PCellData Scalars=\"region\">")?;
+        writeln!(w, "{}", decl(<i32 as LeBytes>::TYPE, "region", 1))?;
+        for name in &STANDARD_CELL_ARRAYS[1..] {
+            writeln!(w, "{}", decl(<f64 as LeBytes>::TYPE, name, 1))?;
+        }
+        for a in extra_cells {
+            let line = match a {
+                CellArray::Int32(n, _) | CellArray::Int32With(n, ..) => {
+                    decl(<i32 as LeBytes>::TYPE, n, 1)
+                }
+                CellArray::Float64(n, _) => decl(<f64 as LeBytes>::TYPE, n, 1),
+                CellArray::Float64Components(n, c, _) => decl(<f64 as LeBytes>::TYPE, n, *c),
+            };
+            writeln!(w, "{line}")?;
+        }
+        writeln!(w, "    </PCellData>")?;
+        writeln!(w, "    <PPoints>")?;
+        writeln!(w, "{}", decl(<f64 as LeBytes>::TYPE, "Points", 3))?;
+        writeln!(w, "    </PPoints>")?;
+        for p in pieces {
+            writeln!(w, "    <Piece Source=\"{}\"/>", xml_escape(p))?;
+        }
+        writeln!(w, "  </PUnstructuredGrid>\n</VTKFile>")
+    })
+}

@@ -3,6 +3,8 @@
 
 pub mod bisect;
 pub mod convert;
+#[cfg(feature = "mpi")]
+pub mod distributed;
 pub mod guard;
 pub mod improve;
 pub mod mesh;

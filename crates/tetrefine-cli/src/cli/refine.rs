@@ -173,7 +173,7 @@ pub enum SmoothScope {
 }
 
 /// The union of every selection option, or `None` for uniform refinement.
-fn mark_strategy(a: &Args) -> Result<Option<MarkStrategy>, String> {
+pub fn mark_strategy(a: &Args) -> Result<Option<MarkStrategy>, String> {
     let mut specs: Vec<String> = a.marks.clone();
     if let Some(r) = &a.region {
         specs.push(format!("region:{r}"));
@@ -204,8 +204,58 @@ fn mark_strategy(a: &Args) -> Result<Option<MarkStrategy>, String> {
     Ok(Some(strategy))
 }
 
+/// The selection of `strategy` on `input` (with `--indicator`), or `None`
+/// for uniform refinement; tells the user how many tets it selects.
+pub fn selection_of(
+    a: &Args,
+    strategy: Option<&MarkStrategy>,
+    input: &tetrefine::TetMesh,
+) -> Result<Option<Vec<bool>>, String> {
+    Ok(match strategy {
+        Some(st) => {
+            let values = match &a.indicator {
+                Some(spec) => {
+                    let v = read_indicator(spec, input).map_err(|e| e.to_string())?;
+                    if spec.to_ascii_lowercase().ends_with(".sol") {
+                        eprintln!("note: --indicator {spec}: read as an error indicator (larger = refine; SolAtVertices: a tet takes the maximum of its vertices); an MMG size map (target edge lengths) is --size FILE.sol");
+                    }
+                    Some(v)
+                }
+                None => None,
+            };
+            super::guard::check_selection(st, input)?;
+            let sel =
+                select(st, values.as_deref(), input).map_err(|e| format!("--mark {st}: {e}"))?;
+            let count = sel.iter().filter(|&&x| x).count();
+            if count == 0 && !a.allow_empty {
+                return Err(format!(
+                    "--mark {st} selects none of the {} tets; nothing would be refined (--allow-empty writes the mesh unrefined)",
+                    input.n_tets()
+                ));
+            }
+            eprintln!("selected {count} of {} tets ({st})", input.n_tets());
+            Some(sel)
+        }
+        None => None,
+    })
+}
+
 /// Runs `refine`.
 pub fn run(a: Args) -> super::CliResult {
+    #[cfg(feature = "mpi")]
+    if super::distributed::wanted(&a) {
+        return super::distributed::run(a);
+    }
+    #[cfg(not(feature = "mpi"))]
+    if a.output
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("pvtu"))
+    {
+        return Err(format!(
+            "{}: a .pvtu is written by distributed runs: build with `--features mpi` and run under mpirun",
+            a.output.display()
+        ));
+    }
     tetrefine::io::Format::for_writing(&a.output).map_err(|e| e.to_string())?;
     super::outputs::refuse_shared_paths(&[
         ("-o", Some(a.output.as_path())),
@@ -310,33 +360,7 @@ pub fn run(a: Args) -> super::CliResult {
             meta.cell_fields.len()
         );
     }
-    let selection = match &strategy {
-        Some(st) => {
-            let values = match &a.indicator {
-                Some(spec) => {
-                    let v = read_indicator(spec, &input).map_err(|e| e.to_string())?;
-                    if spec.to_ascii_lowercase().ends_with(".sol") {
-                        eprintln!("note: --indicator {spec}: read as an error indicator (larger = refine; SolAtVertices: a tet takes the maximum of its vertices); an MMG size map (target edge lengths) is --size FILE.sol");
-                    }
-                    Some(v)
-                }
-                None => None,
-            };
-            super::guard::check_selection(st, &input)?;
-            let sel =
-                select(st, values.as_deref(), &input).map_err(|e| format!("--mark {st}: {e}"))?;
-            let count = sel.iter().filter(|&&x| x).count();
-            if count == 0 && !a.allow_empty {
-                return Err(format!(
-                    "--mark {st} selects none of the {} tets; nothing would be refined (--allow-empty writes the mesh unrefined)",
-                    input.n_tets()
-                ));
-            }
-            eprintln!("selected {count} of {} tets ({st})", input.n_tets());
-            Some(sel)
-        }
-        None => None,
-    };
+    let selection = selection_of(&a, strategy.as_ref(), &input)?;
     let selected = selection
         .as_ref()
         .map_or(input.n_tets(), |s| s.iter().filter(|&&x| x).count()) as u64;

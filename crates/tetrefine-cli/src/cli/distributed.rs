@@ -1,0 +1,346 @@
+//! `tetrefine refine` under `mpirun -n P` (feature `mpi`): rank 0 reads and
+//! partitions, every rank refines its part, the cut moves once for a last
+//! improvement, and the result is written as one `.vtu` piece per rank plus
+//! a `.pvtu` (an `-o *.pvtu`), or gathered into one file of any format.
+//! Rank 0 prints the step table of the whole mesh; every file appears only
+//! when every rank succeeded.
+
+use super::refine::{mark_strategy, selection_of, Args, SmoothScope};
+use super::steps::{peak_rss_bytes, StepStats};
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+use tetrefine::distributed::{self as dist, Comm, DistributedOptions, LocalMesh};
+use tetrefine::io::{CellArray, PointArray, VtuSummary};
+use tetrefine::report::{step_row, step_table_header};
+use tetrefine::{MeshStats, RefineOptions};
+
+/// Whether this `refine` runs distributed: a `.pvtu` output, or a launch by
+/// `mpirun` with more than one rank (Open MPI's, MPICH's or PMIx's
+/// environment says so).
+pub fn wanted(a: &Args) -> bool {
+    if is_pvtu(&a.output) {
+        return true;
+    }
+    ["OMPI_COMM_WORLD_SIZE", "PMI_SIZE", "PMIX_SIZE"]
+        .iter()
+        .filter_map(|k| std::env::var(k).ok())
+        .any(|v| v.trim().parse::<u32>().is_ok_and(|n| n > 1))
+}
+
+/// Whether `p` names a `.pvtu`.
+pub fn is_pvtu(p: &Path) -> bool {
+    p.extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("pvtu"))
+}
+
+/// The `--stats` file of a distributed run.
+#[derive(serde::Serialize)]
+struct StatsFile<'a> {
+    ranks: u32,
+    steps: &'a [StepStats],
+    /// After the cut moved and the band it froze was improved.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    after_cut_move: Option<&'a MeshStats>,
+    /// Peak resident memory of each rank.
+    rank_peak_rss_bytes: Vec<u64>,
+    seconds: f64,
+}
+
+/// Options of the serial command that have no distributed meaning yet.
+fn refuse_serial_only(a: &Args) -> super::CliResult {
+    let refused = [
+        ("--size", a.size.is_some()),
+        ("--size-array", a.size_array.is_some()),
+        ("--hsiz", a.hsiz.is_some()),
+        ("--hmax", a.hmax.is_some()),
+        ("--parent-map", a.parent_map.is_some()),
+        ("--fields", !a.fields.is_empty()),
+        ("--transfer", a.transfer),
+        ("--features-out", a.features_out.is_some()),
+        ("--stop-after", a.stop_after.is_some()),
+    ];
+    match refused.iter().find(|(_, on)| *on) {
+        Some((name, _)) => Err(format!(
+            "{name} is not available in a distributed run (mpirun or a .pvtu output); run it serially"
+        )),
+        None => Ok(()),
+    }
+}
+
+/// Runs `refine` distributed.
+pub fn run(a: Args) -> super::CliResult {
+    refuse_serial_only(&a)?;
+    let pieces = is_pvtu(&a.output);
+    if !pieces {
+        tetrefine::io::Format::for_writing(&a.output).map_err(|e| e.to_string())?;
+    }
+    super::outputs::refuse_shared_paths(&[
+        ("-o", Some(a.output.as_path())),
+        ("--stats", a.stats.as_deref()),
+        ("--histogram", a.histogram.as_deref()),
+    ])?;
+    let n_steps = match a.steps {
+        Some(super::size::Steps::N(n)) => n,
+        None => 1,
+        Some(super::size::Steps::Auto) => {
+            return Err("--steps auto needs a size map, which distributed runs do not take".into())
+        }
+    };
+    if n_steps == 0 && !a.allow_steps_zero {
+        return Err("--steps 0 refines nothing; give --steps N ≥ 1 (or --allow-steps-zero to write the mesh unrefined)".into());
+    }
+    if let Some(h) = &a.histogram {
+        super::check_histogram_path(h)?;
+    }
+    if !(a.threshold > 0.0 && a.threshold < 1.0) {
+        return Err(format!(
+            "--threshold {} must lie in (0, 1) (a sine)",
+            a.threshold
+        ));
+    }
+    if !(a.feature_angle > 0.0 && a.feature_angle < 180.0) {
+        return Err(format!(
+            "--feature-angle {} must lie in (0, 180) degrees",
+            a.feature_angle
+        ));
+    }
+    if let Some(h) = a.hausd {
+        if !(h >= 0.0 && h.is_finite()) {
+            return Err(format!("--hausd {h} must be a finite distance >= 0"));
+        }
+    }
+    let strategy = mark_strategy(&a)?;
+    let (_universe, comm) = dist::init()?;
+    let t0 = Instant::now();
+    let root = comm.rank == 0;
+    // Rank 0 reads; its failure (a bad file) ends every rank.
+    let loaded = if root {
+        load_on_root(&a, strategy.as_ref())
+    } else {
+        Ok(None)
+    };
+    let loaded = comm.agree(loaded)?;
+    let (input, meta, selection) = match loaded {
+        Some((m, meta, s)) => (Some(m), meta, s),
+        None => (None, Default::default(), None),
+    };
+    let mut steps = Vec::new();
+    if let Some(m) = &input {
+        let first = MeshStats::compute(m);
+        crate::say!("{}", step_table_header());
+        crate::say!("{}", step_row("input", &first, 0.0));
+        steps.push(StepStats::input(first));
+        eprintln!(
+            "distributing {} tets over {} ranks (METIS)",
+            m.n_tets(),
+            comm.size
+        );
+    }
+    let (mut local, first_selection) =
+        dist::distribute(&comm, input.as_ref(), selection.as_deref(), n_steps)?;
+    drop(input);
+    let opts = DistributedOptions {
+        refine: RefineOptions {
+            boundary: a.boundary,
+            opt_passes: a.opt_passes,
+            threshold: a.threshold,
+            stop_after: None,
+            selection: None,
+            smooth_refined_only: selection.is_some() && a.smooth == SmoothScope::Refined,
+            step_offset: a.step_offset,
+            check_each_phase: false,
+            effort: a.effort,
+            hausd: a.hausd,
+            interfaces: a.interfaces,
+        },
+        steps: n_steps,
+        improve_across_cut: true,
+    };
+    dist::refine_distributed(
+        &comm,
+        &mut local,
+        first_selection,
+        &opts,
+        |s, stats, report| {
+            if root {
+                crate::say!("{}", step_row(&format!("step {s}"), stats, report.seconds));
+                steps.push(StepStats::step(stats.clone(), report));
+            }
+        },
+    )?;
+    let census = dist::census(&comm, &local.mesh)?;
+    let last = dist::global_stats(&comm, &local.mesh, &census)?;
+    let moved = comm.size > 1 && n_steps > 0;
+    if root && moved {
+        crate::say!("{}", step_row("cut", &last, 0.0));
+    }
+    if root && comm.size > 1 {
+        eprintln!(
+            "cut: {} partition faces ({:.2} % of the {} interior faces)",
+            census.partition_faces / 2,
+            100.0 * census.partition_faces as f64 / 2.0 / last.interior_faces.max(1) as f64,
+            last.interior_faces
+        );
+    }
+    let rss = comm.all_gather(peak_rss_bytes().unwrap_or(0));
+    if root {
+        eprintln!(
+            "peak memory per rank: {}",
+            rss.iter()
+                .map(|b| format!("{:.1} MB", *b as f64 / 1e6))
+                .collect::<Vec<_>>()
+                .join(", ")
+        );
+    }
+    local.mesh.compact();
+    let written = if pieces {
+        write_pieces(&comm, &a.output, &mut local, &last)
+    } else {
+        write_gathered(&comm, &a, &mut local, &meta)
+    };
+    comm.agree(written)?;
+    let extras = if root {
+        write_root_extras(&a, &steps, moved.then_some(&last), rss, t0)
+    } else {
+        Ok(())
+    };
+    comm.agree(extras)?;
+    if root {
+        eprintln!(
+            "wrote {} ({} tets on {} ranks) in {:.2}s",
+            a.output.display(),
+            last.tets,
+            comm.size,
+            t0.elapsed().as_secs_f64()
+        );
+    }
+    Ok(())
+}
+
+type Loaded = (
+    tetrefine::TetMesh,
+    tetrefine::io::MeshMeta,
+    Option<Vec<bool>>,
+);
+
+/// Rank 0: the input with its features and the selection.
+fn load_on_root(
+    a: &Args,
+    strategy: Option<&tetrefine::MarkStrategy>,
+) -> Result<Option<Loaded>, String> {
+    let (mut input, meta) = super::load_with_meta(&a.input)?;
+    let selection = selection_of(a, strategy, &input)?;
+    super::apply_feature_option(&mut input, &a.features, a.feature_angle, a.interfaces)?;
+    Ok(Some((input, meta, selection)))
+}
+
+/// `OUT_r.vtu` beside `OUT.pvtu` for rank `r`.
+fn piece_path(pvtu: &Path, rank: u32) -> PathBuf {
+    let stem = pvtu
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    pvtu.with_file_name(format!("{stem}_{rank}.vtu"))
+}
+
+/// One `.vtu` per rank (with `GlobalPointIds`, `rank`, `level`, `parent`
+/// and the quality arrays) and, on rank 0, the `.pvtu` listing them.
+fn write_pieces(
+    comm: &Comm,
+    pvtu: &Path,
+    local: &mut LocalMesh,
+    global: &MeshStats,
+) -> Result<(), String> {
+    let ids = dist::global_point_ids(comm, &local.mesh)?;
+    dist::strip_partition_markers(local);
+    let mesh = &local.mesh;
+    let gids = ids
+        .iter()
+        .map(|&g| i32::try_from(g).map_err(|_| format!("global point id {g} exceeds Int32")))
+        .collect::<Result<Vec<i32>, String>>()?;
+    let n = mesh.n_tets();
+    let rank = comm.rank as i32;
+    let level = |i: usize| i32::from(mesh.level(i as u32));
+    let parent = |i: usize| mesh.parent(i as u32) as i32;
+    let rank_of = |_: usize| rank;
+    let cells = vec![
+        CellArray::Int32With("level".into(), n, &level),
+        CellArray::Int32With("parent".into(), n, &parent),
+        CellArray::Int32With("rank".into(), n, &rank_of),
+    ];
+    let points = vec![PointArray::Int32("GlobalPointIds".into(), 1, gids)];
+    let valence = MeshStats::vertex_valence(mesh);
+    let summary = VtuSummary {
+        valence: &valence,
+        histogram_counts: &global.histogram.counts,
+        histogram_edges_deg: &global.histogram.edges_deg,
+    };
+    let piece = piece_path(pvtu, comm.rank);
+    tetrefine::io::write_vtu_with(&piece, mesh, Some(&summary), &cells, &points)
+        .map_err(|e| e.to_string())?;
+    if comm.rank == 0 {
+        let names: Vec<String> = (0..comm.size)
+            .map(|r| {
+                piece_path(pvtu, r)
+                    .file_name()
+                    .map(|s| s.to_string_lossy().into_owned())
+                    .unwrap_or_default()
+            })
+            .collect();
+        tetrefine::io::write_pvtu(pvtu, &names, true, &cells, &points)
+            .map_err(|e| e.to_string())?;
+    }
+    Ok(())
+}
+
+/// The union gathered on rank 0 and written there in `-o`'s format.
+fn write_gathered(
+    comm: &Comm,
+    a: &Args,
+    local: &mut LocalMesh,
+    meta: &tetrefine::io::MeshMeta,
+) -> Result<(), String> {
+    let gathered = dist::gather(comm, local)?;
+    let Some(mut mesh) = gathered else {
+        return Ok(());
+    };
+    let options = tetrefine::io::WriteOptions {
+        msh_format: a.msh_format,
+    };
+    super::write_refined(
+        &a.output,
+        &mut mesh,
+        &[],
+        meta,
+        &options,
+        (Vec::new(), Vec::new()),
+    )
+}
+
+/// Rank 0: `--stats` and `--histogram` of the whole mesh.
+fn write_root_extras(
+    a: &Args,
+    steps: &[StepStats],
+    after: Option<&MeshStats>,
+    rss: Vec<u64>,
+    t0: Instant,
+) -> super::CliResult {
+    if let Some(path) = &a.stats {
+        let file = StatsFile {
+            ranks: rss.len() as u32,
+            steps,
+            after_cut_move: after,
+            rank_peak_rss_bytes: rss,
+            seconds: t0.elapsed().as_secs_f64(),
+        };
+        let text = serde_json::to_string_pretty(&file).map_err(|e| e.to_string())?;
+        tetrefine::io::write_atomic(path, |w| std::io::Write::write_all(w, text.as_bytes()))
+            .map_err(|e| e.to_string())?;
+    }
+    if let Some(h) = &a.histogram {
+        let last = after.unwrap_or(&steps.last().expect("input entry").stats);
+        super::write_histogram(h, last)?;
+    }
+    Ok(())
+}

@@ -1,0 +1,402 @@
+//! Distributed √3 refinement over MPI (feature `mpi`), in the manner of
+//! ParMmg (Cirrottola–Froehly): the mesh is cut into parts, each rank
+//! refines its part with the serial step while the cut stays frozen, then
+//! the cut moves and the band that was frozen is improved.
+//!
+//! 1. **Partition.** Rank 0 holds the input; METIS cuts its dual graph
+//!    ([`partition_dual_graph`]), each tet weighted by the tets it will
+//!    become (a selected tet of an adaptive run weighs 6 per step, the
+//!    √3 step's growth). Each rank receives its tets as a self-contained
+//!    part: points, tags, regions, `level`, `parent` (global input ids), and
+//!    its cut faces as partition faces ([`crate::PartitionMarker`]) naming
+//!    the rank across.
+//! 2. **Refine.** The serial step runs on every part. A partition face is
+//!    refined like a linear interface — split at its canonical centroid,
+//!    never flipped, never moved — so both sides create the same points
+//!    without talking. In an adaptive step the ranks first tell each other,
+//!    face by face, whether the tet on their side is refined; a face whose
+//!    other side is not stays whole (held), as a serial interface does.
+//! 3. **Improve across the cut.** Once every step is done, each tet with a
+//!    vertex on the cut moves to the lowest rank holding such a vertex
+//!    (migration of one layer), so the old cut lies inside a part, and the
+//!    optimize phase runs again with only the new cut frozen.
+//! 4. **Census.** After each step the ranks check that the cut conforms
+//!    (every partition face held by exactly two ranks), reduce the
+//!    statistics of the union ([`global_stats`]) and, at the end, number
+//!    the points globally ([`global_point_ids`]).
+//!
+//! Every collective is preceded by an agreement ([`Comm::agree`]): one
+//! rank's failure ends every rank with an error, never a hang.
+
+mod comm;
+mod cut;
+mod part;
+mod partition;
+
+pub use comm::{Comm, OTHER_RANK_FAILED};
+pub use cut::{census, global_point_ids, global_stats, Census};
+pub use part::{MarkerSlots, Part};
+pub use partition::partition_dual_graph;
+
+use crate::mesh::partition::PartitionMarker;
+use crate::mesh::TetMesh;
+use crate::refine::step::descendants_of_last_step;
+use crate::report::MeshStats;
+use crate::{RefineOptions, StepReport};
+use cut::{across_faces, face_key_of, partition_faces};
+use part::FaceFate;
+
+/// A rank's share of a distributed refinement.
+pub struct LocalMesh {
+    /// This rank's tets; its cut faces carry partition markers.
+    pub mesh: TetMesh,
+    /// The user markers partition faces carry, by slot.
+    pub slots: MarkerSlots,
+}
+
+/// How often the cut moves by one layer after the last step, each move
+/// followed by the optimize phase.
+const CUT_MOVES: usize = 3;
+
+/// Options of [`refine_distributed`].
+#[derive(Clone, Debug)]
+pub struct DistributedOptions {
+    /// The serial step's options; `selection` is rank 0's, per input tet.
+    pub refine: RefineOptions,
+    /// Number of √3 steps.
+    pub steps: usize,
+    /// Move the cut after the last step and improve the band it froze.
+    pub improve_across_cut: bool,
+}
+
+/// Splits rank 0's `input` into one part per rank, METIS on the dual graph
+/// weighted by the work each tet brings; every rank gets its part.
+pub fn distribute(
+    comm: &Comm,
+    input: Option<&TetMesh>,
+    selection: Option<&[bool]>,
+    steps: usize,
+) -> Result<(LocalMesh, Option<Vec<bool>>), String> {
+    let prepared = match input {
+        Some(mesh) if comm.rank == 0 => prepare_parts(comm.size, mesh, selection, steps),
+        _ if comm.rank == 0 => Err("rank 0 holds no input mesh".to_string()),
+        _ => Ok((Vec::new(), MarkerSlots::default())),
+    };
+    let (messages, slots) = comm.agree(prepared)?;
+    let mut w = part::Wire::default();
+    slots.markers.iter().for_each(|&m| w.i32(m));
+    let slot_bytes = comm.broadcast(w.0);
+    let mut r = part::Reader {
+        bytes: &slot_bytes,
+        at: 0,
+    };
+    let mut markers = Vec::new();
+    while !r.done() {
+        markers.push(r.i32()?);
+    }
+    let slots = MarkerSlots { markers };
+    let out = if comm.rank == 0 {
+        messages
+    } else {
+        vec![Vec::new(); comm.size as usize]
+    };
+    let got = comm.exchange(out)?;
+    let built = Part::decode(&got[0])
+        .and_then(Part::build)
+        .map_err(|e| format!("rank {}: its part: {e}", comm.rank));
+    let (mesh, selected) = comm.agree(built)?;
+    // Only rank 0 knows whether the run is adaptive.
+    let adaptive = comm.sum(&[u64::from(comm.rank == 0 && selection.is_some())])[0] > 0;
+    let selected = adaptive.then_some(selected);
+    Ok((LocalMesh { mesh, slots }, selected))
+}
+
+/// Rank 0's side of [`distribute`]: one encoded part per rank.
+fn prepare_parts(
+    size: u32,
+    mesh: &TetMesh,
+    selection: Option<&[bool]>,
+    steps: usize,
+) -> Result<(Vec<Vec<u8>>, MarkerSlots), String> {
+    let slots = MarkerSlots::of(mesh)?;
+    let ids: Vec<u32> = mesh.tet_ids().collect();
+    let grow = 6i32.saturating_pow(steps.min(8) as u32);
+    let weight: Vec<i32> = ids
+        .iter()
+        .map(|&t| match selection {
+            Some(s) if !s.get(t as usize).copied().unwrap_or(false) => 1,
+            _ => grow,
+        })
+        .collect();
+    let part_of_dense = partition_dual_graph(mesh, size, &weight)?;
+    let mut part_of = vec![0u32; mesh.n_tet_slots()];
+    for (i, &t) in ids.iter().enumerate() {
+        part_of[t as usize] = part_of_dense[i];
+    }
+    let mut by_rank: Vec<Vec<u32>> = vec![Vec::new(); size as usize];
+    for &t in &ids {
+        by_rank[part_of[t as usize] as usize].push(t);
+    }
+    if let Some(r) = by_rank.iter().position(Vec::is_empty) {
+        return Err(format!(
+            "METIS left rank {r} without tetrahedra; run on fewer ranks"
+        ));
+    }
+    Ok((
+        by_rank
+            .iter()
+            .enumerate()
+            .map(|(r, tets)| {
+                let mut p = Part::from_tets(mesh, tets, &slots, selection, |t, f| {
+                    let h = mesh.adj(t)[f];
+                    if h == crate::NO_ADJ {
+                        FaceFate::Domain
+                    } else if part_of[(h >> 2) as usize] as usize != r {
+                        FaceFate::Cut(part_of[(h >> 2) as usize])
+                    } else {
+                        FaceFate::Interior
+                    }
+                });
+                // The input tet's own id: the `parent` of every descendant.
+                p.parent = tets.clone();
+                p.encode()
+            })
+            .collect(),
+        slots,
+    ))
+}
+
+/// Refines every rank's part `opts.steps` times, then (with
+/// `improve_across_cut`) moves the cut and improves the band it froze.
+/// `on_step(step, union_stats, this_rank_report)` runs on every rank after
+/// each step with the statistics of the union.
+pub fn refine_distributed(
+    comm: &Comm,
+    local: &mut LocalMesh,
+    first_selection: Option<Vec<bool>>,
+    opts: &DistributedOptions,
+    mut on_step: impl FnMut(usize, &MeshStats, &StepReport),
+) -> Result<(), String> {
+    let adaptive = first_selection.is_some();
+    let mut step_opts = opts.refine.clone();
+    step_opts.selection = first_selection;
+    for s in 1..=opts.steps {
+        if s > 1 && adaptive {
+            step_opts.selection = Some(descendants_of_last_step(&local.mesh, s - 1));
+        }
+        if adaptive {
+            hold_faces_across_unrefined_tets(comm, &mut local.mesh, &step_opts)?;
+        }
+        let report = crate::refine_step(&mut local.mesh, s, &step_opts);
+        release_held_faces(&mut local.mesh);
+        let c = census(comm, &local.mesh)?;
+        let stats = global_stats(comm, &local.mesh, &c)?;
+        on_step(s, &stats, &report);
+    }
+    if opts.improve_across_cut && comm.size > 1 {
+        let mut o = opts.refine.clone();
+        o.selection = None;
+        for _ in 0..CUT_MOVES {
+            if !migrate_cut_layer(comm, local)? {
+                break;
+            }
+            crate::refine::step::optimize_phase(&mut local.mesh, opts.steps, &o, false);
+            census(comm, &local.mesh)?;
+        }
+    }
+    Ok(())
+}
+
+/// Before an adaptive step: a partition face whose tet on the other rank
+/// is not refined is held (not split), as the serial step leaves an
+/// interface face whole unless both its tets are split.
+fn hold_faces_across_unrefined_tets(
+    comm: &Comm,
+    mesh: &mut TetMesh,
+    opts: &RefineOptions,
+) -> Result<(), String> {
+    let sel = opts.selection.as_deref().unwrap_or(&[]);
+    let selected = |t: u32| u32::from(sel.get(t as usize).copied().unwrap_or(false));
+    let across = across_faces(comm, mesh, selected)?;
+    for (t, f, pm) in partition_faces(mesh) {
+        if across.get(&face_key_of(mesh, t, f)) == Some(&0) {
+            let held = PartitionMarker { hold: true, ..pm };
+            mesh.set_face_marker(mesh.face_vertices(t, f), held.encode());
+        }
+    }
+    Ok(())
+}
+
+/// After a step: every held face is an ordinary partition face again.
+fn release_held_faces(mesh: &mut TetMesh) {
+    let held: Vec<([u32; 3], PartitionMarker)> = mesh
+        .face_markers()
+        .iter()
+        .filter_map(|(f, &m)| {
+            PartitionMarker::decode(m)
+                .filter(|p| p.hold)
+                .map(|p| (*f, p))
+        })
+        .collect();
+    for (f, pm) in held {
+        let free = PartitionMarker { hold: false, ..pm };
+        mesh.set_face_marker(f, free.encode());
+    }
+}
+
+/// Moves every tet with a vertex on the cut to the lowest rank holding
+/// such a vertex (as far as the partition faces at its vertices tell), and
+/// rebuilds each rank's mesh: the old cut is then inside a part.
+///
+/// Returns whether the cut moved.
+fn migrate_cut_layer(comm: &Comm, local: &mut LocalMesh) -> Result<bool, String> {
+    let mesh = &local.mesh;
+    let me = comm.rank;
+    let mut lowest = vec![u32::MAX; mesh.n_points()];
+    for (t, f, pm) in partition_faces(mesh) {
+        for v in mesh.face_vertices(t, f) {
+            let l = &mut lowest[v as usize];
+            *l = (*l).min(pm.neighbour);
+        }
+    }
+    let mut dest = vec![me; mesh.n_tet_slots()];
+    for t in mesh.tet_ids() {
+        for v in mesh.tet(t) {
+            dest[t as usize] = dest[t as usize].min(lowest[v as usize]);
+        }
+    }
+    let across = across_faces(comm, mesh, |t| dest[t as usize])?;
+    let mut by_rank: Vec<Vec<u32>> = vec![Vec::new(); comm.size as usize];
+    for t in mesh.tet_ids() {
+        by_rank[dest[t as usize] as usize].push(t);
+    }
+    // A rank whose every tet touches the cut would be left empty: then the
+    // cut stays where it is (every rank learns it from the same sum).
+    let after = comm.sum(&by_rank.iter().map(|b| b.len() as u64).collect::<Vec<_>>());
+    if after.contains(&0) {
+        return Ok(false);
+    }
+    let mut unmatched = 0usize;
+    let mut parts: Vec<Part> = by_rank
+        .iter()
+        .map(|tets| {
+            Part::from_tets(mesh, tets, &local.slots, None, |t, f| {
+                let h = mesh.adj(t)[f];
+                let other = if h == crate::NO_ADJ {
+                    let fv = mesh.face_vertices(t, f);
+                    let is_cut = mesh
+                        .face_marker(fv)
+                        .is_some_and(crate::mesh::partition::is_partition_marker);
+                    if !is_cut {
+                        return FaceFate::Domain;
+                    }
+                    match across.get(&face_key_of(mesh, t, f)) {
+                        Some(&o) => o,
+                        None => {
+                            unmatched += 1;
+                            return FaceFate::Domain;
+                        }
+                    }
+                } else {
+                    dest[(h >> 2) as usize]
+                };
+                if other == dest[t as usize] {
+                    FaceFate::Interior
+                } else {
+                    FaceFate::Cut(other)
+                }
+            })
+        })
+        .collect();
+    comm.agree(if unmatched > 0 {
+        Err(format!(
+            "rank {me}: {unmatched} partition faces unmatched before migration"
+        ))
+    } else {
+        Ok(())
+    })?;
+    let out: Vec<Vec<u8>> = parts
+        .iter()
+        .enumerate()
+        .map(|(r, p)| {
+            if r as u32 == me || p.data.tets.is_empty() {
+                Vec::new()
+            } else {
+                p.encode()
+            }
+        })
+        .collect();
+    let got = comm.exchange(out)?;
+    // In rank order (the own part at its own rank), so the rebuilt mesh is
+    // the same whatever the message timing.
+    let mut all = Vec::with_capacity(got.len());
+    for (r, bytes) in got.iter().enumerate() {
+        if r as u32 == me {
+            all.push(std::mem::take(&mut parts[r]));
+        } else if !bytes.is_empty() {
+            all.push(Part::decode(bytes).map_err(|e| format!("rank {me}: from rank {r}: {e}"))?);
+        }
+    }
+    all.retain(|p| !p.data.tets.is_empty());
+    let rebuilt = Part::merge(all).build().map(|(m, _)| m);
+    local.mesh = comm.agree(rebuilt)?;
+    Ok(true)
+}
+
+/// Starts MPI (the returned universe finalises it when dropped; keep it
+/// until the last collective) and wraps its world communicator.
+pub fn init() -> Result<(mpi::environment::Universe, Comm), String> {
+    let universe =
+        mpi::initialize().ok_or_else(|| "MPI was initialised twice in one process".to_string())?;
+    let comm = Comm::new(universe.world());
+    Ok((universe, comm))
+}
+
+/// Every partition face of `local` gets its own user marker back (or
+/// none): what a piece or a gathered file carries.
+pub fn strip_partition_markers(local: &mut LocalMesh) {
+    let cut: Vec<([u32; 3], PartitionMarker)> = local
+        .mesh
+        .face_markers()
+        .iter()
+        .filter_map(|(f, &m)| PartitionMarker::decode(m).map(|p| (*f, p)))
+        .collect();
+    for (f, pm) in cut {
+        local
+            .mesh
+            .set_face_marker(f, local.slots.marker(pm.user_slot));
+    }
+}
+
+/// Gathers every rank's mesh on rank 0 as one mesh (points on the cut
+/// merged, partition faces interior again); `None` on the other ranks.
+pub fn gather(comm: &Comm, local: &LocalMesh) -> Result<Option<TetMesh>, String> {
+    let mesh = &local.mesh;
+    let tets: Vec<u32> = mesh.tet_ids().collect();
+    let part = Part::from_tets(mesh, &tets, &local.slots, None, |t, f| {
+        if mesh.adj(t)[f] != crate::NO_ADJ {
+            return FaceFate::Interior;
+        }
+        let cut = mesh
+            .face_marker(mesh.face_vertices(t, f))
+            .is_some_and(crate::mesh::partition::is_partition_marker);
+        if cut {
+            FaceFate::Interior
+        } else {
+            FaceFate::Domain
+        }
+    });
+    let mut out = vec![Vec::new(); comm.size as usize];
+    out[0] = part.encode();
+    let got = comm.exchange(out)?;
+    let merged = if comm.rank == 0 {
+        got.iter()
+            .map(|b| Part::decode(b))
+            .collect::<Result<Vec<_>, _>>()
+            .and_then(|parts| Part::merge(parts).build())
+            .map(|(m, _)| Some(m))
+    } else {
+        Ok(None)
+    };
+    comm.agree(merged)
+}

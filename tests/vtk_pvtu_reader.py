@@ -1,0 +1,63 @@
+"""Reads a .pvtu written by `mpirun -n 2 tetrefine refine meshes/tripod.vtu
+X.pvtu --boundary linear` with VTK's own parallel reader (the code ParaView
+runs) and checks it against the input read by VTK itself: every piece is
+found, the tets are VTK tetrahedra with positive volumes (VTK's
+vtkCellSizeFilter) summing to the input's volume (the linear rule keeps the
+domain), the arrays region, quality, rank and GlobalPointIds are there, the
+ranks are 0 and 1, and the global ids number the points of the union
+densely (0 .. n-1, a point on the cut once).
+
+Usage: python3 tests/vtk_pvtu_reader.py X.pvtu INPUT.vtu     (needs `pip install vtk`)
+"""
+
+import sys
+
+import vtk
+from vtk.util.numpy_support import vtk_to_numpy
+
+
+def volume(grid):
+    f = vtk.vtkCellSizeFilter()
+    f.SetInputData(grid)
+    f.ComputeVolumeOn()
+    f.Update()
+    v = vtk_to_numpy(f.GetOutput().GetCellData().GetArray("Volume"))
+    assert v.min() > 0, v.min()
+    return v.sum()
+
+
+def main(pvtu, original):
+    reader = vtk.vtkXMLPUnstructuredGridReader()
+    reader.SetFileName(pvtu)
+    reader.Update()
+    if reader.GetErrorCode() != 0:
+        sys.exit(f"{pvtu}: VTK reader error {reader.GetErrorCode()}")
+    grid = reader.GetOutput()
+    n = grid.GetNumberOfCells()
+    assert n > 0
+    assert all(grid.GetCellType(i) == vtk.VTK_TETRA for i in range(n))
+    cells = grid.GetCellData()
+    for name in ["region", "quality", "min_dihedral", "rank", "level", "parent"]:
+        a = cells.GetArray(name)
+        assert a is not None and a.GetNumberOfTuples() == n, name
+    ranks = sorted(set(vtk_to_numpy(cells.GetArray("rank")).tolist()))
+    assert ranks == [0, 1], ranks
+    gids = grid.GetPointData().GetArray("GlobalPointIds")
+    assert gids is not None
+    g = vtk_to_numpy(gids)
+    unique = sorted(set(g.tolist()))
+    assert unique == list(range(len(unique))), "global ids are not 0..n-1"
+    # Points on the cut appear once per piece holding them.
+    assert len(g) > len(unique), (len(g), len(unique))
+
+    inp = vtk.vtkXMLUnstructuredGridReader()
+    inp.SetFileName(original)
+    inp.Update()
+    v_in, v_out = volume(inp.GetOutput()), volume(grid)
+    assert abs(v_in - v_out) <= 1e-9 * v_in, (v_in, v_out)
+    print(f"{pvtu}: VTK {vtk.vtkVersion.GetVTKVersion()} reads {n} tets in 2 pieces, "
+          f"{len(unique)} global points, volume {v_out:.6g} = input's: ok")
+
+
+if __name__ == "__main__":
+    main(sys.argv[1], sys.argv[2])
