@@ -197,14 +197,61 @@ pub fn refine_distributed(
         let mut o = opts.refine.clone();
         o.selection = None;
         for _ in 0..CUT_MOVES {
+            let frozen = cut_point_keys(&local.mesh);
             if !migrate_cut_layer(comm, local)? {
                 break;
             }
-            crate::refine::step::optimize_phase(&mut local.mesh, opts.steps, &o, false);
+            let zone = band_zone(
+                &local.mesh,
+                &frozen,
+                opts.refine.smooth_refined_only,
+                opts.steps,
+            );
+            crate::refine::step::optimize_phase(&mut local.mesh, opts.steps, &o, false, Some(zone));
             census(comm, &local.mesh)?;
         }
     }
     Ok(())
+}
+
+/// The exact coordinates of every point on a partition face.
+fn cut_point_keys(mesh: &TetMesh) -> std::collections::HashSet<part::PointKey> {
+    partition_faces(mesh)
+        .into_iter()
+        .flat_map(|(t, f, _)| mesh.face_vertices(t, f))
+        .map(|v| part::point_key(mesh.point(v)))
+        .collect()
+}
+
+/// The band a cut froze, once it has moved: the tets with a vertex at one
+/// of `frozen`'s points, and their vertices (per point, per tet slot). With
+/// `refined_only` (`--smooth refined`), only the tets refined in the last
+/// step count.
+fn band_zone(
+    mesh: &TetMesh,
+    frozen: &std::collections::HashSet<part::PointKey>,
+    refined_only: bool,
+    step: usize,
+) -> (Vec<bool>, Vec<bool>) {
+    let on_cut: Vec<bool> = mesh
+        .points()
+        .iter()
+        .map(|&p| frozen.contains(&part::point_key(p)))
+        .collect();
+    let refined = refined_only.then(|| descendants_of_last_step(mesh, step));
+    let mut tets = vec![false; mesh.n_tet_slots()];
+    let mut verts = vec![false; mesh.n_points()];
+    for t in mesh.tet_ids() {
+        let v = mesh.tet(t);
+        let allowed = refined.as_ref().is_none_or(|r| r[t as usize]);
+        if allowed && v.iter().any(|&x| on_cut[x as usize]) {
+            tets[t as usize] = true;
+            for x in v {
+                verts[x as usize] = true;
+            }
+        }
+    }
+    (verts, tets)
 }
 
 /// Before an adaptive step: a partition face whose tet on the other rank

@@ -156,7 +156,7 @@ pub fn refine_step_with_progress(
                 // The topological phases appended tets and points at the ends
                 // of the arrays; bring neighbours together in memory first.
                 mesh.reorder_spatially_in_place();
-                report.improve = optimize_phase(mesh, step, opts, true);
+                report.improve = optimize_phase(mesh, step, opts, true, None);
             }
         }
         progress.phase_end();
@@ -181,19 +181,23 @@ pub fn refine_step_with_progress(
 /// Phase 6: edge removal and smoothing, then (at the efforts that have it)
 /// the long-edge round and its settling passes, over the zone
 /// `--smooth` allows. Also run, without the long-edge round
-/// (`long_edges`), by the distributed driver once the cut has moved, so
-/// that the band frozen along it is improved too without splitting the
-/// rest of the mesh a second time.
+/// (`long_edges`) and over the band the cut froze (`zone`: per point, may
+/// it move; per tet slot, may its edges go), by the distributed driver once
+/// the cut has moved.
 pub(crate) fn optimize_phase(
     mesh: &mut TetMesh,
     step: usize,
     opts: &RefineOptions,
     long_edges: bool,
+    zone: Option<(Vec<bool>, Vec<bool>)>,
 ) -> crate::improve::ImproveReport {
     if opts.opt_passes == 0 {
         return crate::improve::ImproveReport::default();
     }
-    let (movable, tet_allowed) = smoothing_zone(mesh, step, opts);
+    let (movable, tet_allowed) = match zone {
+        Some((verts, tets)) => (Some(verts), Some(tets)),
+        None => smoothing_zone(mesh, step, opts),
+    };
     let mut io = ImproveOptions {
         movable,
         tet_allowed,
