@@ -169,12 +169,14 @@ fn prepare_parts(
 /// Refines every rank's part `opts.steps` times, then (with
 /// `improve_across_cut`) moves the cut and improves the band it froze.
 /// `on_step(step, union_stats, this_rank_report)` runs on every rank after
-/// each step with the statistics of the union.
+/// each step with the statistics of the union; `progress` hears this
+/// rank's phases (the command line shows rank 0's).
 pub fn refine_distributed(
     comm: &Comm,
     local: &mut LocalMesh,
     first_selection: Option<Vec<bool>>,
     opts: &DistributedOptions,
+    progress: &dyn crate::Progress,
     mut on_step: impl FnMut(usize, &MeshStats, &StepReport),
 ) -> Result<(), String> {
     let adaptive = first_selection.is_some();
@@ -187,7 +189,8 @@ pub fn refine_distributed(
         if adaptive {
             hold_faces_across_unrefined_tets(comm, &mut local.mesh, &step_opts)?;
         }
-        let report = crate::refine_step(&mut local.mesh, s, &step_opts);
+        let report =
+            crate::refine::refine_step_with_progress(&mut local.mesh, s, &step_opts, progress);
         release_held_faces(&mut local.mesh);
         let c = census(comm, &local.mesh)?;
         let stats = global_stats(comm, &local.mesh, &c)?;
@@ -373,6 +376,9 @@ fn migrate_cut_layer(comm: &Comm, local: &mut LocalMesh) -> Result<bool, String>
             }
         })
         .collect();
+    // The old mesh is in the parts now: free it before the rebuild, which
+    // would otherwise hold both.
+    local.mesh = TetMesh::default();
     let got = comm.exchange(out)?;
     // In rank order (the own part at its own rank), so the rebuilt mesh is
     // the same whatever the message timing.

@@ -5,6 +5,7 @@
 //! Rank 0 prints the step table of the whole mesh; every file appears only
 //! when every rank succeeded.
 
+use super::progress::BarProgress;
 use super::refine::{mark_strategy, selection_of, Args, SmoothScope};
 use super::steps::{peak_rss_bytes, StepStats};
 use std::path::{Path, PathBuf};
@@ -157,18 +158,30 @@ pub fn run(a: Args) -> super::CliResult {
         steps: n_steps,
         improve_across_cut: true,
     };
+    // Rank 0's phases drive the bar (the parts are balanced by METIS).
+    let bar = root.then(|| BarProgress::new(n_steps, tetrefine::Phase::ALL.len()));
+    let progress: &dyn tetrefine::Progress = match &bar {
+        Some(b) => b,
+        None => &tetrefine::NoProgress,
+    };
     dist::refine_distributed(
         &comm,
         &mut local,
         first_selection,
         &opts,
+        progress,
         |s, stats, report| {
-            if root {
-                crate::say!("{}", step_row(&format!("step {s}"), stats, report.seconds));
+            if let Some(b) = &bar {
+                b.suspend(|| {
+                    crate::say!("{}", step_row(&format!("step {s}"), stats, report.seconds))
+                });
                 steps.push(StepStats::step(stats.clone(), report));
             }
         },
     )?;
+    if let Some(b) = &bar {
+        b.finish();
+    }
     let census = dist::census(&comm, &local.mesh)?;
     let last = dist::global_stats(&comm, &local.mesh, &census)?;
     let moved = comm.size > 1 && n_steps > 0;
