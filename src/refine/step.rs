@@ -325,6 +325,21 @@ fn partition_of(mesh: &TetMesh, fv: [u32; 3]) -> Option<PartitionMarker> {
     mesh.face_marker(fv).and_then(PartitionMarker::decode)
 }
 
+/// Where phase 3 splits face `fv`: its centroid (a partition face's in the
+/// canonical order), or `None` for a held partition face.
+fn face_split_point(
+    mesh: &TetMesh,
+    fv: [u32; 3],
+    partition: Option<PartitionMarker>,
+) -> Option<DVec3> {
+    let p = fv.map(|x| mesh.point(x));
+    match partition {
+        Some(pm) if pm.hold => None,
+        Some(_) => Some(canonical_centroid(p)),
+        None => Some((p[0] + p[1] + p[2]) / 3.0),
+    }
+}
+
 /// Phase 3: 1-3 split of every boundary face of a split tet at its
 /// barycentre, and the 2-6 split of every interface face whose two tets were
 /// split. Partition faces are split at their canonical centroid unless held.
@@ -352,14 +367,9 @@ fn boundary_split_phase(mesh: &mut TetMesh, st: &mut StepState, report: &mut Ste
     }
     for (t, f) in faces {
         let fv = mesh.face_vertices(t, f);
-        let p = fv.map(|x| mesh.point(x));
         let partition = partition_of(mesh, fv);
-        if partition.is_some_and(|pm| pm.hold) {
+        let Some(c) = face_split_point(mesh, fv, partition) else {
             continue;
-        }
-        let c = match partition {
-            Some(_) => canonical_centroid(p),
-            None => (p[0] + p[1] + p[2]) / 3.0,
         };
         if let Ok((m, _)) = split_boundary_face(mesh, t, f, c) {
             if partition.is_some() {
@@ -372,14 +382,9 @@ fn boundary_split_phase(mesh: &mut TetMesh, st: &mut StepState, report: &mut Ste
     }
     for (t, f) in interfaces {
         let fv = mesh.face_vertices(t, f);
-        let p = fv.map(|x| mesh.point(x));
         let partition = partition_of(mesh, fv);
-        if partition.is_some_and(|pm| pm.hold) {
+        let Some(c) = face_split_point(mesh, fv, partition) else {
             continue;
-        }
-        let c = match partition {
-            Some(_) => canonical_centroid(p),
-            None => (p[0] + p[1] + p[2]) / 3.0,
         };
         let (rt, ru) = (mesh.region(t), mesh.region(mesh.adj(t)[f] >> 2));
         if let Ok(m) = split_interface_face(mesh, t, f, c) {

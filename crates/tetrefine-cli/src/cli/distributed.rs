@@ -94,23 +94,7 @@ pub fn run(a: Args) -> super::CliResult {
     if let Some(h) = &a.histogram {
         super::check_histogram_path(h)?;
     }
-    if !(a.threshold > 0.0 && a.threshold < 1.0) {
-        return Err(format!(
-            "--threshold {} must lie in (0, 1) (a sine)",
-            a.threshold
-        ));
-    }
-    if !(a.feature_angle > 0.0 && a.feature_angle < 180.0) {
-        return Err(format!(
-            "--feature-angle {} must lie in (0, 180) degrees",
-            a.feature_angle
-        ));
-    }
-    if let Some(h) = a.hausd {
-        if !(h >= 0.0 && h.is_finite()) {
-            return Err(format!("--hausd {h} must be a finite distance >= 0"));
-        }
-    }
+    super::refine::check_numbers(&a)?;
     let strategy = mark_strategy(&a)?;
     let (_universe, comm) = dist::init()?;
     let t0 = Instant::now();

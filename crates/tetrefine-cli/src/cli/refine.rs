@@ -240,6 +240,28 @@ pub fn selection_of(
     })
 }
 
+/// `--threshold`, `--feature-angle` and `--hausd` within their ranges.
+pub fn check_numbers(a: &Args) -> super::CliResult {
+    if !(a.threshold > 0.0 && a.threshold < 1.0) {
+        return Err(format!(
+            "--threshold {} must lie in (0, 1) (a sine)",
+            a.threshold
+        ));
+    }
+    if !(a.feature_angle > 0.0 && a.feature_angle < 180.0) {
+        return Err(format!(
+            "--feature-angle {} must lie in (0, 180) degrees",
+            a.feature_angle
+        ));
+    }
+    if let Some(h) = a.hausd {
+        if !(h >= 0.0 && h.is_finite()) {
+            return Err(format!("--hausd {h} must be a finite distance >= 0"));
+        }
+    }
+    Ok(())
+}
+
 /// Runs `refine`.
 pub fn run(a: Args) -> super::CliResult {
     #[cfg(feature = "mpi")]
@@ -303,25 +325,9 @@ pub fn run(a: Args) -> super::CliResult {
     if let Some(h) = &a.histogram {
         super::check_histogram_path(h)?;
     }
-    if !(a.threshold > 0.0 && a.threshold < 1.0) {
-        return Err(format!(
-            "--threshold {} must lie in (0, 1) (a sine)",
-            a.threshold
-        ));
-    }
-    if !(a.feature_angle > 0.0 && a.feature_angle < 180.0) {
-        return Err(format!(
-            "--feature-angle {} must lie in (0, 180) degrees",
-            a.feature_angle
-        ));
-    }
+    check_numbers(&a)?;
     if let Some(f) = &a.features_out {
         tetrefine::PolylineFormat::of(f).map_err(|e| e.to_string())?;
-    }
-    if let Some(h) = a.hausd {
-        if !(h >= 0.0 && h.is_finite()) {
-            return Err(format!("--hausd {h} must be a finite distance >= 0"));
-        }
     }
     let strategy = mark_strategy(&a)?;
     let (mut input, mut meta) = super::load_with_meta(&a.input)?;
