@@ -54,9 +54,12 @@ pub struct LocalMesh {
     pub slots: MarkerSlots,
 }
 
-/// How often the cut moves by one layer after the last step, each move
-/// followed by the optimize phase.
-const CUT_MOVES: usize = 3;
+/// How often the cut moves after the last step, each move followed by the
+/// optimize phase over the band it froze.
+const CUT_MOVES: usize = 1;
+/// Layers of tets each move carries across: with two, the band along the
+/// old cut (one layer) keeps a free layer between it and the new cut.
+const CUT_LAYERS: usize = 2;
 
 /// Options of [`refine_distributed`].
 #[derive(Clone, Debug)]
@@ -199,19 +202,30 @@ pub fn refine_distributed(
     if opts.improve_across_cut && comm.size > 1 {
         let mut o = opts.refine.clone();
         o.selection = None;
-        for _ in 0..CUT_MOVES {
+        for k in 1..=CUT_MOVES {
+            let t0 = std::time::Instant::now();
             let frozen = cut_point_keys(&local.mesh);
-            if !migrate_cut_layer(comm, local)? {
+            if !migrate_cut_layer(comm, local, CUT_LAYERS)? {
                 break;
             }
+            let t1 = std::time::Instant::now();
             let zone = band_zone(
                 &local.mesh,
                 &frozen,
                 opts.refine.smooth_refined_only,
                 opts.steps,
             );
+            let band = zone.1.iter().filter(|&&b| b).count() as u64;
             crate::refine::step::optimize_phase(&mut local.mesh, opts.steps, &o, false, Some(zone));
             census(comm, &local.mesh)?;
+            let band = comm.sum(&[band])[0];
+            if comm.rank == 0 && std::env::var_os("TETREFINE_QUIET").is_none() {
+                eprintln!(
+                    "cut move {k}/{CUT_MOVES}: {band} tets in the band, migration {:.2} s, optimize {:.2} s (rank 0)",
+                    (t1 - t0).as_secs_f64(),
+                    t1.elapsed().as_secs_f64()
+                );
+            }
         }
     }
     Ok(())
@@ -299,7 +313,7 @@ fn release_held_faces(mesh: &mut TetMesh) {
 /// rebuilds each rank's mesh: the old cut is then inside a part.
 ///
 /// Returns whether the cut moved.
-fn migrate_cut_layer(comm: &Comm, local: &mut LocalMesh) -> Result<bool, String> {
+fn migrate_cut_layer(comm: &Comm, local: &mut LocalMesh, layers: usize) -> Result<bool, String> {
     let mesh = &local.mesh;
     let me = comm.rank;
     let mut lowest = vec![u32::MAX; mesh.n_points()];
@@ -310,9 +324,20 @@ fn migrate_cut_layer(comm: &Comm, local: &mut LocalMesh) -> Result<bool, String>
         }
     }
     let mut dest = vec![me; mesh.n_tet_slots()];
-    for t in mesh.tet_ids() {
-        for v in mesh.tet(t) {
-            dest[t as usize] = dest[t as usize].min(lowest[v as usize]);
+    for layer in 0..layers {
+        if layer > 0 {
+            // The next layer: the lowest destination of a tet at each point.
+            for t in mesh.tet_ids() {
+                for v in mesh.tet(t) {
+                    let l = &mut lowest[v as usize];
+                    *l = (*l).min(dest[t as usize]);
+                }
+            }
+        }
+        for t in mesh.tet_ids() {
+            for v in mesh.tet(t) {
+                dest[t as usize] = dest[t as usize].min(lowest[v as usize]);
+            }
         }
     }
     let across = across_faces(comm, mesh, |t| dest[t as usize])?;
