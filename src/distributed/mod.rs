@@ -16,10 +16,11 @@
 //!    without talking. In an adaptive step the ranks first tell each other,
 //!    face by face, whether the tet on their side is refined; a face whose
 //!    other side is not stays whole (held), as a serial interface does.
-//! 3. **Improve across the cut.** Once every step is done, each tet with a
-//!    vertex on the cut moves to the lowest rank holding such a vertex
-//!    (migration of one layer), so the old cut lies inside a part, and the
-//!    optimize phase runs again with only the new cut frozen.
+//! 3. **Improve across the cut.** Once every step is done, the tets within
+//!    two layers of the cut move to the lowest rank holding one of their
+//!    vertices, so the old cut lies inside a part with a free layer before
+//!    the new cut, and the optimize phase runs again over the band the old
+//!    cut froze, with only the new cut frozen.
 //! 4. **Census.** After each step the ranks check that the cut conforms
 //!    (every partition face held by exactly two ranks), reduce the
 //!    statistics of the union ([`global_stats`]) and, at the end, number
@@ -308,9 +309,10 @@ fn release_held_faces(mesh: &mut TetMesh) {
     }
 }
 
-/// Moves every tet with a vertex on the cut to the lowest rank holding
-/// such a vertex (as far as the partition faces at its vertices tell), and
-/// rebuilds each rank's mesh: the old cut is then inside a part.
+/// Moves every tet within `layers` layers of the cut to the lowest rank
+/// holding one of its vertices (as far as the partition faces at its
+/// vertices tell), and rebuilds each rank's mesh: the old cut is then
+/// inside a part.
 ///
 /// Returns whether the cut moved.
 fn migrate_cut_layer(comm: &Comm, local: &mut LocalMesh, layers: usize) -> Result<bool, String> {
