@@ -401,3 +401,115 @@ fn a_bad_input_ends_every_rank_with_an_error_and_no_output() {
     assert!(String::from_utf8_lossy(&o.stderr).contains("--hsiz"));
     assert!(!out.exists());
 }
+
+/// Area of the marked faces (boundary and interior), per marker.
+fn marked_areas(m: &TetMesh) -> BTreeMap<i32, f64> {
+    let mut out = BTreeMap::new();
+    for t in m.tet_ids() {
+        for f in 0..4 {
+            let fv = m.face_vertices(t, f);
+            // Boundary faces, and interior marked faces once.
+            let h = m.adj(t)[f];
+            if h == NO_ADJ || (h >> 2) > t {
+                if let Some(k) = m.face_marker(fv) {
+                    let p = fv.map(|v| m.point(v));
+                    *out.entry(k).or_insert(0.0) += 0.5 * (p[1] - p[0]).cross(p[2] - p[0]).length();
+                }
+            }
+        }
+    }
+    out
+}
+
+#[test]
+fn face_markers_survive_the_cut_with_their_exact_areas() {
+    // The tripod with its boundary marked 1 or 2 by the side of x = 0 and
+    // an interior marked surface (marker 7) between the tets on either side
+    // of z = 0, which METIS's cut crosses. Under the linear rule every
+    // marked patch keeps its area exactly: a marker lost on a cut face, or
+    // a cut face left marked, would change a patch's area or add a marker.
+    let dir = tempfile::tempdir().unwrap();
+    let mut m = input("meshes/tripod.mesh");
+    let centre = |m: &TetMesh, t: u32| m.tet_points(t).iter().copied().sum::<glam::DVec3>() / 4.0;
+    for t in 0..m.n_tets() as u32 {
+        for f in 0..4 {
+            let fv = m.face_vertices(t, f);
+            let h = m.adj(t)[f];
+            if h == NO_ADJ {
+                let x: f64 = fv.iter().map(|&v| m.point(v).x).sum();
+                m.set_face_marker(fv, Some(if x < 0.0 { 1 } else { 2 }));
+            } else if (centre(&m, t).z < 0.0) != (centre(&m, h >> 2).z < 0.0) {
+                m.set_face_marker(fv, Some(7));
+            }
+        }
+    }
+    let marked = dir.path().join("marked.mesh");
+    tetrefine::write_mesh(&marked, &m).unwrap();
+    let want = marked_areas(&m);
+    assert_eq!(want.len(), 3);
+    // The cut the two ranks get (METIS is deterministic) crosses marked
+    // faces, which then travel as partition faces carrying their marker.
+    let part = partition_dual_graph(&m, 2, &vec![6; m.n_tets()]).unwrap();
+    let cut_marked = (0..m.n_tets() as u32)
+        .flat_map(|t| (0..4).map(move |f| (t, f)))
+        .filter(|&(t, f)| {
+            let h = m.adj(t)[f];
+            h != NO_ADJ
+                && part[t as usize] != part[(h >> 2) as usize]
+                && m.face_marker(m.face_vertices(t, f)) == Some(7)
+        })
+        .count();
+    assert!(cut_marked > 0, "the fixture must cut marked faces");
+    let out = dir.path().join("m.mesh");
+    mpirun_ok(
+        2,
+        &[
+            "refine",
+            marked.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+            "--boundary",
+            "linear",
+        ],
+    );
+    let (g, _) = tetrefine::io::load_mesh(&out).unwrap();
+    let got = marked_areas(&g);
+    assert_eq!(
+        got.keys().collect::<Vec<_>>(),
+        want.keys().collect::<Vec<_>>()
+    );
+    for (k, a) in &want {
+        assert!(close(got[k], *a, 1e-9), "marker {k}: {} vs {a}", got[k]);
+    }
+}
+
+#[test]
+fn a_rank_that_dies_ends_the_job_without_a_hang_or_output() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("o.pvtu");
+    let script = format!(
+        "if [ \"$OMPI_COMM_WORLD_RANK\" = 1 ]; then kill -9 $$; else exec {} refine meshes/gmsh_t16.mesh -o {} --steps 2; fi",
+        env!("CARGO_BIN_EXE_tetrefine"),
+        out.display()
+    );
+    let o = Command::new("timeout")
+        .args([
+            "300",
+            "mpirun",
+            "--allow-run-as-root",
+            "--oversubscribe",
+            "-n",
+            "2",
+            "sh",
+            "-c",
+        ])
+        .arg(&script)
+        .current_dir(support::root())
+        .output()
+        .unwrap();
+    // timeout(1) exits 124 when it had to stop a hung job.
+    assert_ne!(o.status.code(), Some(124), "the job hung");
+    assert!(!o.status.success());
+    let left: Vec<_> = std::fs::read_dir(dir.path()).unwrap().collect();
+    assert!(left.is_empty(), "{left:?}");
+}
