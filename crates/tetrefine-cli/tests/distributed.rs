@@ -222,6 +222,7 @@ fn serial_with_marked_cut(
     steps: usize,
     boundary: Sqrt3Rule,
     select: Option<&[bool]>,
+    stop_after: Option<tetrefine::Phase>,
 ) -> usize {
     let mut mesh = input(name);
     tetrefine::detect_features_for(&mut mesh, 45.0, tetrefine::InterfaceRule::Linear);
@@ -252,6 +253,7 @@ fn serial_with_marked_cut(
         opt_passes: 0,
         selection: select.map(<[bool]>::to_vec),
         smooth_refined_only: select.is_some(),
+        stop_after,
         ..RefineOptions::default()
     };
     tetrefine::refine(&mut mesh, steps, &opts);
@@ -277,13 +279,22 @@ fn counts_equal_the_serial_steps_with_the_same_cut_marked() {
     // Step 1 under every rule; two steps under the linear rule, whose
     // boundary points stay put (under a smoothing rule the faces along the
     // cut see a partial surface, so step 2's refusals may differ by a few).
-    for (steps, boundary, rule, select) in [
-        (1, Sqrt3Rule::Linear, "linear", None),
-        (1, Sqrt3Rule::Interpolating, "interpolating", None),
-        (2, Sqrt3Rule::Linear, "linear", None),
-        (2, Sqrt3Rule::Linear, "linear", Some(&in_box[..])),
+    // And one step stopped after the boundary split (`--stop-after`).
+    use tetrefine::Phase;
+    for (steps, boundary, rule, select, stop) in [
+        (1, Sqrt3Rule::Linear, "linear", None, None),
+        (1, Sqrt3Rule::Interpolating, "interpolating", None, None),
+        (2, Sqrt3Rule::Linear, "linear", None, None),
+        (2, Sqrt3Rule::Linear, "linear", Some(&in_box[..]), None),
+        (
+            1,
+            Sqrt3Rule::Interpolating,
+            "interpolating",
+            None,
+            Some(Phase::BoundarySplit),
+        ),
     ] {
-        let expected = serial_with_marked_cut(name, steps, boundary, select);
+        let expected = serial_with_marked_cut(name, steps, boundary, select, stop);
         let out = dir.path().join("c.pvtu");
         let stats = dir.path().join("c.json");
         let steps_s = steps.to_string();
@@ -304,6 +315,9 @@ fn counts_equal_the_serial_steps_with_the_same_cut_marked() {
         if select.is_some() {
             args.extend(["--box", bx]);
         }
+        if stop.is_some() {
+            args.extend(["--stop-after", "boundary-split"]);
+        }
         mpirun_ok(2, &args);
         let got = final_stats(&stats)["tets"].as_u64().unwrap() as usize;
         assert_eq!(
@@ -322,9 +336,31 @@ fn a_gathered_output_keeps_feature_edges_corners_and_regions() {
     let dir = tempfile::tempdir().unwrap();
     for name in ["meshes/tripod.mesh", "meshes/gmsh_t16.mesh"] {
         let serial = dir.path().join("s.mesh");
-        serial_ok(&["refine", name, "-o", serial.to_str().unwrap()]);
+        let (s_lines, g_lines) = (dir.path().join("s.csv"), dir.path().join("g.csv"));
+        serial_ok(&[
+            "refine",
+            name,
+            "-o",
+            serial.to_str().unwrap(),
+            "--features-out",
+            s_lines.to_str().unwrap(),
+        ]);
         let out = dir.path().join("g.mesh");
-        mpirun_ok(2, &["refine", name, "-o", out.to_str().unwrap()]);
+        mpirun_ok(
+            2,
+            &[
+                "refine",
+                name,
+                "-o",
+                out.to_str().unwrap(),
+                "--features-out",
+                g_lines.to_str().unwrap(),
+            ],
+        );
+        // `--features-out` writes the union's lines: as many rows as the
+        // serial run's (the same edges; vertices may slide along lines).
+        let rows = |p: &Path| std::fs::read_to_string(p).unwrap().lines().count();
+        assert_eq!(rows(&g_lines), rows(&s_lines), "{name}");
         let (s, _) = tetrefine::io::load_mesh(&serial).unwrap();
         let (g, _) = tetrefine::io::load_mesh(&out).unwrap();
         g.check().unwrap();

@@ -58,8 +58,6 @@ fn refuse_serial_only(a: &Args) -> super::CliResult {
         ("--parent-map", a.parent_map.is_some()),
         ("--fields", !a.fields.is_empty()),
         ("--transfer", a.transfer),
-        ("--features-out", a.features_out.is_some()),
-        ("--stop-after", a.stop_after.is_some()),
     ];
     match refused.iter().find(|(_, on)| *on) {
         Some((name, _)) => Err(format!(
@@ -80,7 +78,11 @@ pub fn run(a: Args) -> super::CliResult {
         ("-o", Some(a.output.as_path())),
         ("--stats", a.stats.as_deref()),
         ("--histogram", a.histogram.as_deref()),
+        ("--features-out", a.features_out.as_deref()),
     ])?;
+    if let Some(f) = &a.features_out {
+        tetrefine::PolylineFormat::of(f).map_err(|e| e.to_string())?;
+    }
     let n_steps = match a.steps {
         Some(super::size::Steps::N(n)) => n,
         None => 1,
@@ -130,7 +132,7 @@ pub fn run(a: Args) -> super::CliResult {
             boundary: a.boundary,
             opt_passes: a.opt_passes,
             threshold: a.threshold,
-            stop_after: None,
+            stop_after: a.stop_after,
             selection: None,
             smooth_refined_only: selection.is_some() && a.smooth == SmoothScope::Refined,
             step_offset: a.step_offset,
@@ -140,7 +142,8 @@ pub fn run(a: Args) -> super::CliResult {
             interfaces: a.interfaces,
         },
         steps: n_steps,
-        improve_across_cut: true,
+        // A step stopped early has not optimised: the cut stays.
+        improve_across_cut: a.stop_after.is_none(),
     };
     // Rank 0's phases drive the bar (the parts are balanced by METIS).
     let bar = root.then(|| BarProgress::new(n_steps, tetrefine::Phase::ALL.len()));
@@ -191,12 +194,23 @@ pub fn run(a: Args) -> super::CliResult {
         );
     }
     local.mesh.compact();
+    // The union on rank 0: the output itself, or the feature lines' source.
+    let mut union = if !pieces || a.features_out.is_some() {
+        dist::gather(&comm, &local)?
+    } else {
+        None
+    };
     let written = if pieces {
         write_pieces(&comm, &a.output, &mut local, &last)
     } else {
-        write_gathered(&comm, &a, &mut local, &meta)
+        write_union(&a, union.as_mut(), &meta)
     };
     comm.agree(written)?;
+    let lines = match (&a.features_out, &union) {
+        (Some(f), Some(m)) => super::write_feature_lines(f, m),
+        _ => Ok(()),
+    };
+    comm.agree(lines)?;
     let extras = if root {
         write_root_extras(&a, &steps, moved.then_some(&last), rss, t0)
     } else {
@@ -291,15 +305,13 @@ fn write_pieces(
     Ok(())
 }
 
-/// The union gathered on rank 0 and written there in `-o`'s format.
-fn write_gathered(
-    comm: &Comm,
+/// Rank 0 writes the gathered union in `-o`'s format (`None` elsewhere).
+fn write_union(
     a: &Args,
-    local: &mut LocalMesh,
+    union: Option<&mut tetrefine::TetMesh>,
     meta: &tetrefine::io::MeshMeta,
 ) -> Result<(), String> {
-    let gathered = dist::gather(comm, local)?;
-    let Some(mut mesh) = gathered else {
+    let Some(mesh) = union else {
         return Ok(());
     };
     let options = tetrefine::io::WriteOptions {
@@ -307,7 +319,7 @@ fn write_gathered(
     };
     super::write_refined(
         &a.output,
-        &mut mesh,
+        mesh,
         &[],
         meta,
         &options,
