@@ -174,7 +174,8 @@ fn prepare_parts(
 /// `improve_across_cut`) moves the cut and improves the band it froze.
 /// `on_step(step, union_stats, this_rank_report)` runs on every rank after
 /// each step with the statistics of the union; `progress` hears this
-/// rank's phases (the command line shows rank 0's).
+/// rank's phases (the command line shows rank 0's). Returns the census and
+/// the union's statistics of the final mesh.
 pub fn refine_distributed(
     comm: &Comm,
     local: &mut LocalMesh,
@@ -182,8 +183,11 @@ pub fn refine_distributed(
     opts: &DistributedOptions,
     progress: &dyn crate::Progress,
     mut on_step: impl FnMut(usize, &MeshStats, &StepReport),
-) -> Result<(), String> {
+) -> Result<(Census, MeshStats), String> {
     let adaptive = first_selection.is_some();
+    // The census and statistics of the mesh as it stands, so that the end
+    // reuses the last ones instead of taking them again.
+    let mut last = None;
     let mut step_opts = opts.refine.clone();
     step_opts.selection = first_selection;
     for s in 1..=opts.steps {
@@ -199,6 +203,7 @@ pub fn refine_distributed(
         let c = census(comm, &local.mesh)?;
         let stats = global_stats(comm, &local.mesh, &c)?;
         on_step(s, &stats, &report);
+        last = Some((c, stats));
     }
     if opts.improve_across_cut && comm.size > 1 {
         let mut o = opts.refine.clone();
@@ -218,9 +223,10 @@ pub fn refine_distributed(
             );
             let band = zone.1.iter().filter(|&&b| b).count() as u64;
             crate::refine::step::optimize_phase(&mut local.mesh, opts.steps, &o, false, Some(zone));
-            census(comm, &local.mesh)?;
+            let c = census(comm, &local.mesh)?;
+            last = Some((c, global_stats(comm, &local.mesh, &c)?));
             let band = comm.sum(&[band])[0];
-            if comm.rank == 0 && std::env::var_os("TETREFINE_QUIET").is_none() {
+            if comm.rank == 0 {
                 eprintln!(
                     "cut move {k}/{CUT_MOVES}: {band} tets in the band, migration {:.2} s, optimize {:.2} s (rank 0)",
                     (t1 - t0).as_secs_f64(),
@@ -229,7 +235,13 @@ pub fn refine_distributed(
             }
         }
     }
-    Ok(())
+    match last {
+        Some(l) => Ok(l),
+        None => {
+            let c = census(comm, &local.mesh)?;
+            Ok((c, global_stats(comm, &local.mesh, &c)?))
+        }
+    }
 }
 
 /// The exact coordinates of every point on a partition face.

@@ -151,7 +151,7 @@ pub fn run(a: Args) -> super::CliResult {
         Some(b) => b,
         None => &tetrefine::NoProgress,
     };
-    dist::refine_distributed(
+    let (census, last) = dist::refine_distributed(
         &comm,
         &mut local,
         first_selection,
@@ -169,8 +169,6 @@ pub fn run(a: Args) -> super::CliResult {
     if let Some(b) = &bar {
         b.finish();
     }
-    let census = dist::census(&comm, &local.mesh)?;
-    let last = dist::global_stats(&comm, &local.mesh, &census)?;
     let moved = comm.size > 1 && n_steps > 0;
     if root && moved {
         crate::say!("{}", step_row("cut", &last, 0.0));
