@@ -688,7 +688,8 @@ impl Mesh {
     ///                 move inside their patch and along feature lines,
     ///                 sliver caps removed) or 'best' [--effort].
     ///   hausd         Hausdorff bound of boundary moves (MMG's -hausd);
-    ///                 None: 5 % of the local edge length [--hausd].
+    ///                 None: 5 % of the local edge length (15 % of a
+    ///                 sliver cap's mean edge for its removal) [--hausd].
     ///   interfaces    'linear' (material interfaces split flat, exact
     ///                 region volumes) or 'sqrt3' (smoothed on both sides by
     ///                 the boundary rule) [--interfaces].
@@ -883,7 +884,8 @@ impl Mesh {
     /// `--features auto` does) — `tetrefine improve`. Returns a new Mesh whose
     /// `reports` hold one dict (passes, edges_removed, laplacian_moves,
     /// optimized_moves, surface_moves, line_moves, caps_removed,
-    /// long_edges_split; improve alone never splits).
+    /// long_edges_split, boundary_flips, edges_contracted; improve alone
+    /// never splits).
     ///
     ///   opt_passes     Maximum passes of edge removal + smoothing
     ///                  [--opt-passes] (default 5).
@@ -892,7 +894,8 @@ impl Mesh {
     ///   effort         'fast' (boundary fixed), 'default' or 'best'
     ///                  [--effort].
     ///   hausd          Hausdorff bound of boundary moves; None: 5 % of the
-    ///                  local edge length [--hausd].
+    ///                  local edge length (15 % of a sliver cap's mean edge
+    ///                  for its removal) [--hausd].
     ///   features       'auto' or 'none' [--features].
     ///   feature_angle  Crease angle for 'auto', degrees [--feature-angle].
     #[pyo3(signature = (opt_passes=5, *, threshold=0.3, effort="default", hausd=None,

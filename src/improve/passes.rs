@@ -109,6 +109,9 @@ pub struct ImproveReport {
     pub long_edges_split: usize,
     /// Boundary edges flipped ([`crate::ops::flip_boundary_edge`]).
     pub boundary_flips: usize,
+    /// Short edges contracted, an interior vertex merged into a neighbour
+    /// ([`crate::ops::contract_edge`]).
+    pub edges_contracted: usize,
 }
 
 impl ImproveReport {
@@ -123,6 +126,7 @@ impl ImproveReport {
         self.caps_removed += other.caps_removed;
         self.long_edges_split += other.long_edges_split;
         self.boundary_flips += other.boundary_flips;
+        self.edges_contracted += other.edges_contracted;
     }
 }
 
@@ -215,7 +219,7 @@ pub fn improve(mesh: &mut TetMesh, opts: &ImproveOptions) -> ImproveReport {
         }
     }
     let fixed = mesh.fixed_vertices();
-    let movable: Vec<bool> = (0..mesh.n_points())
+    let mut movable: Vec<bool> = (0..mesh.n_points())
         .map(|v| {
             !fixed[v]
                 && opts
@@ -236,9 +240,15 @@ pub fn improve(mesh: &mut TetMesh, opts: &ImproveOptions) -> ImproveReport {
         .boundary
         .as_ref()
         .map(|b| BoundarySmoother::new(mesh, b.clone()));
-    for _ in 0..opts.passes {
+    for pass in 0..opts.passes {
         report.passes += 1;
         let mut changed = edges.pass(mesh, &mut tr, opts, &mut report);
+        // Contractions wait for one pass of smoothing: on the raw step
+        // they took out 5–20 % of the tets and ended lower in the worst
+        // angle on four of the seven shipped meshes (two steps).
+        if pass > 0 {
+            changed += contract_pass(mesh, &mut tr, &mut movable, opts, &mut report);
+        }
         changed += smooth_pass(mesh, &mut tr, &movable, opts, &mut report);
         if let Some(s) = &surface {
             changed += boundary_pass(mesh, &mut tr, s, opts, &mut report);
@@ -258,6 +268,72 @@ pub fn improve(mesh: &mut TetMesh, opts: &ImproveOptions) -> ImproveReport {
         }
     }
     report
+}
+
+/// Contractions of the short edges of the tets below `opts.threshold`
+/// ([`crate::ops::contract_edge`]): for each such tet, in slot order, its
+/// edges from the shortest, each end that may move merged into the other,
+/// where that raises the worst tet of the merged vertex's ball. A sliver
+/// whose short edge joins an interior vertex to one that may not move
+/// (after a step, a new point crowded against the boundary) keeps that
+/// edge through every flip and smoothing move; only the contraction takes
+/// it out. Returns the number of contractions.
+fn contract_pass(
+    mesh: &mut TetMesh,
+    tr: &mut Tracker,
+    movable: &mut [bool],
+    opts: &ImproveOptions,
+    report: &mut ImproveReport,
+) -> usize {
+    let candidates: Vec<u32> = (0..mesh.n_tet_slots() as u32)
+        .filter(|&t| mesh.is_alive(t) && tr.tq[t as usize] < opts.threshold && tr.is_allowed(t))
+        .collect();
+    let mut ball = Vec::new();
+    let mut scratch = Vec::new();
+    let mut contracted = 0;
+    for t in candidates {
+        if !mesh.is_alive(t) || tr.tq[t as usize] >= opts.threshold {
+            continue;
+        }
+        let tv = mesh.tet(t);
+        let p = mesh.tet_points(t);
+        let mut order: [usize; 6] = [0, 1, 2, 3, 4, 5];
+        let len = |e: usize| p[TET_EDGES[e][0]].distance_squared(p[TET_EDGES[e][1]]);
+        order.sort_by(|&a, &b| len(a).total_cmp(&len(b)));
+        'edges: for e in order {
+            let [i, j] = TET_EDGES[e];
+            for (v, u) in [(tv[i], tv[j]), (tv[j], tv[i])] {
+                if !movable[v as usize] {
+                    continue;
+                }
+                mesh.ball(v, &mut ball);
+                if !ball.iter().all(|&b| tr.is_allowed(b)) {
+                    continue;
+                }
+                let beat = ball
+                    .iter()
+                    .map(|&b| tr.tq[b as usize])
+                    .fold(f64::INFINITY, f64::min);
+                if let Ok(new) = crate::ops::contract_edge(mesh, v, u, beat, &mut scratch) {
+                    tr.grow(mesh.n_tet_slots());
+                    for &b in &ball {
+                        tr.tq[b as usize] = f64::INFINITY;
+                    }
+                    for n in new {
+                        if let Some(a) = &mut tr.allowed {
+                            a[n as usize] = true;
+                        }
+                        tr.set(mesh, n, tet_min_sine(&mesh.tet_points(n)));
+                    }
+                    movable[v as usize] = false;
+                    contracted += 1;
+                    break 'edges;
+                }
+            }
+        }
+    }
+    report.edges_contracted += contracted;
+    contracted
 }
 
 /// 2-2 (and m → 2m − 2) flips of boundary edges ([`flip_boundary_edge`]) of
@@ -371,7 +447,7 @@ fn cap_pass(
             .sum::<f64>()
             / 6.0;
         let limits = CapLimits {
-            hausd: b.hausd.unwrap_or(b.hausd_rel * mean_edge),
+            hausd: b.hausd.unwrap_or(b.cap_hausd_rel * mean_edge),
             crease_angle: b.crease_angle,
         };
         let verts = mesh.tet(t);

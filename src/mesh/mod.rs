@@ -187,6 +187,17 @@ impl TetMesh {
         (self.points.len() - 1) as u32
     }
 
+    /// Marks point `v` as used by no tet (after an operation such as an edge
+    /// contraction took it out of every tet); [`Self::compact`] drops it.
+    pub(crate) fn retire_point(&mut self, v: u32) {
+        debug_assert!(
+            self.tet_of_vertex(v)
+                .is_none_or(|t| !self.is_alive(t) || !self.tets[t as usize].contains(&v)),
+            "point {v} retired while a tet holds it"
+        );
+        self.v2t[v as usize] = DEAD;
+    }
+
     /// Removes point `v` if it is the last one and no tet uses it (undoing an
     /// `add_point` of a refused operation).
     pub fn pop_unused_point(&mut self, v: u32) {

@@ -125,12 +125,11 @@ fn uniform_small_meshes_two_steps() {
     }
 }
 
-/// Issue 14, still open: with the paper-like feature angle of 69° fewer
-/// creases are tagged, and getfem_ladder's second interpolating step ends
-/// at 4.02° (input 5.34°), at a corner whose tets the boundary smoother may
-/// not move.
+/// With the paper-like feature angle of 69° fewer creases are tagged; the
+/// tightest case is getfem_ladder's second interpolating step (5.55°
+/// against the input's 5.34°, at a corner whose tets the boundary smoother
+/// may not move; 4.02° before edge contraction).
 #[test]
-#[ignore = "issue 14 open: getfem_ladder, interpolating, 69°, step 2 ends at 4.02° < 5.34°"]
 fn uniform_small_meshes_two_steps_at_69_degrees() {
     for name in SMALL {
         uniform(name, 2, &[69.0]);
