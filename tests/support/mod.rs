@@ -26,3 +26,23 @@ pub fn root() -> &'static Path {
 pub fn path(rel: &str) -> PathBuf {
     root().join(rel)
 }
+
+/// A Medit ASCII solution, written by hand: `kw` with `rows` of values.
+pub fn write_sol(path: &Path, kw: &str, types: &[u8], rows: &[Vec<f64>]) {
+    let mut s = format!(
+        "MeshVersionFormatted 2\n\nDimension 3\n\n{kw}\n{}\n{}",
+        rows.len(),
+        types.len()
+    );
+    for t in types {
+        s += &format!(" {t}");
+    }
+    s += "\n";
+    for r in rows {
+        let line: Vec<String> = r.iter().map(|x| format!("{x:?}")).collect();
+        s += &line.join(" ");
+        s += "\n";
+    }
+    s += "\nEnd\n";
+    std::fs::write(path, s).unwrap();
+}

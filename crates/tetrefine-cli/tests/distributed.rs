@@ -438,6 +438,173 @@ fn a_bad_input_ends_every_rank_with_an_error_and_no_output() {
     assert!(!out.exists());
 }
 
+/// A tet's corners by their bits, sorted: the same tet in any numbering.
+fn corner_bits(p: [glam::DVec3; 4]) -> [[u64; 3]; 4] {
+    let mut k = p.map(|x| x.to_array().map(f64::to_bits));
+    k.sort();
+    k
+}
+
+#[test]
+fn smooth_refined_keeps_far_tets_bit_identical_on_every_rank() {
+    // The box over one leg and the hub crosses the cut; a tet whose
+    // corners all lie more than two of the input's longest edges away from
+    // it shares no vertex with a refined tet, on whichever rank it is.
+    let dir = tempfile::tempdir().unwrap();
+    let name = "meshes/tripod.mesh";
+    let m = input(name);
+    let longest = m
+        .tet_ids()
+        .flat_map(|t| {
+            let p = m.tet_points(t);
+            (0..4).flat_map(move |i| (i + 1..4).map(move |j| p[i].distance(p[j])))
+        })
+        .fold(0.0, f64::max);
+    let (lo, hi) = (
+        glam::DVec3::new(-5.0, -5.0, -5.0),
+        glam::DVec3::new(5.0, 5.0, 20.0),
+    );
+    let far: Vec<[[u64; 3]; 4]> = m
+        .tet_ids()
+        .map(|t| m.tet_points(t))
+        .filter(|p| {
+            p.iter()
+                .all(|&x| (x - x.clamp(lo, hi)).length() > 2.0 * longest)
+        })
+        .map(corner_bits)
+        .collect();
+    assert!(far.len() > m.n_tets() / 4, "{} far tets", far.len());
+    let out = dir.path().join("s.mesh");
+    mpirun_ok(
+        2,
+        &[
+            "refine",
+            name,
+            "-o",
+            out.to_str().unwrap(),
+            "--box",
+            "-5,-5,-5,5,5,20",
+            "--smooth",
+            "refined",
+        ],
+    );
+    let (got, _) = tetrefine::io::load_mesh(&out).unwrap();
+    let kept: std::collections::HashSet<[[u64; 3]; 4]> = got
+        .tet_ids()
+        .map(|t| corner_bits(got.tet_points(t)))
+        .collect();
+    let moved = far.iter().filter(|k| !kept.contains(*k)).count();
+    assert_eq!(moved, 0, "{moved} of {} far tets changed", far.len());
+}
+
+/// `f` of the serial transfer test: linear, so interpolation is exact.
+fn field(p: [f64; 3]) -> f64 {
+    2.0 + 0.5 * p[0] - 1.5 * p[1] + 0.25 * p[2]
+}
+
+#[test]
+fn a_gathered_output_carries_fields_and_the_parent_map() {
+    let dir = tempfile::tempdir().unwrap();
+    let tripod = input("meshes/tripod.mesh");
+    let pts: Vec<[f64; 3]> = tripod.points().iter().map(|p| p.to_array()).collect();
+    let fp = dir.path().join("f.sol");
+    let rows: Vec<Vec<f64>> = pts.iter().map(|&p| vec![field(p)]).collect();
+    support::write_sol(&fp, "SolAtVertices", &[1], &rows);
+    let cp = dir.path().join("cells.sol");
+    let rows: Vec<Vec<f64>> = (0..tripod.n_tets()).map(|t| vec![1.5 * t as f64]).collect();
+    support::write_sol(&cp, "SolAtTetrahedra", &[1], &rows);
+    for ranks in [1, 2] {
+        let out = dir.path().join(format!("out{ranks}.mesh"));
+        let map = dir.path().join(format!("map{ranks}.txt"));
+        let o = mpirun_ok(
+            ranks,
+            &[
+                "refine",
+                "meshes/tripod.mesh",
+                "-o",
+                out.to_str().unwrap(),
+                "--boundary",
+                "linear",
+                "--steps",
+                "2",
+                "--fields",
+                fp.to_str().unwrap(),
+                "--fields",
+                cp.to_str().unwrap(),
+                "--parent-map",
+                map.to_str().unwrap(),
+            ],
+        );
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(err.contains("transfer: 1 point and 1 cell fields"), "{err}");
+        // The Medit output's fields beside it, read back by the core's
+        // reader: the linear field at every output point, the cell field
+        // 1.5 × the input tet each tet's parent map line names.
+        let (mesh, _) = tetrefine::io::load_mesh(&out).unwrap();
+        mesh.check().unwrap();
+        let mut meta = tetrefine::io::MeshMeta::default();
+        let sol = out.with_extension("sol");
+        let tets_sol = dir.path().join(format!("out{ranks}.tets.sol"));
+        tetrefine::io::add_sol_fields(&sol, &mut meta, mesh.n_points(), mesh.n_tets()).unwrap();
+        tetrefine::io::add_sol_fields(&tets_sol, &mut meta, mesh.n_points(), mesh.n_tets())
+            .unwrap();
+        let f = &meta.point_fields[0].values;
+        for (i, p) in mesh.points().iter().enumerate() {
+            assert!(
+                (f[i] - field(p.to_array())).abs() <= 1e-9,
+                "{ranks} ranks, point {i}"
+            );
+        }
+        let text = std::fs::read_to_string(&map).unwrap();
+        let (tets, points) = text.split_once("# points").expect("a points section");
+        let parents: Vec<f64> = tets
+            .lines()
+            .filter(|l| !l.starts_with('#') && !l.trim().is_empty())
+            .map(|l| l.split_whitespace().nth(1).unwrap().parse().unwrap())
+            .collect();
+        assert_eq!(parents.len(), mesh.n_tets());
+        let cells = &meta.cell_fields[0].values;
+        for (t, &p) in parents.iter().enumerate() {
+            assert_eq!(cells[t], 1.5 * p, "{ranks} ranks, tet {t}");
+        }
+        // Each point is the barycentric combination of its input tet's
+        // corners that the map gives.
+        let mut n = 0;
+        for l in points.lines().skip(1).filter(|l| !l.trim().is_empty()) {
+            let r: Vec<f64> = l.split_whitespace().map(|x| x.parse().unwrap()).collect();
+            let mut x = [0.0; 3];
+            for k in 0..4 {
+                let q = pts[r[2 + k] as usize];
+                for a in 0..3 {
+                    x[a] += r[6 + k] * q[a];
+                }
+            }
+            let p = mesh.point(r[0] as u32).to_array();
+            for a in 0..3 {
+                assert!((x[a] - p[a]).abs() <= 1e-9, "{ranks} ranks, point {}", r[0]);
+            }
+            n += 1;
+        }
+        assert_eq!(n, mesh.n_points());
+    }
+    // A .pvtu cannot carry them: refused by name, nothing written.
+    let out = dir.path().join("o.pvtu");
+    let o = mpirun(
+        2,
+        &[
+            "refine",
+            "meshes/tripod.mesh",
+            "-o",
+            out.to_str().unwrap(),
+            "--fields",
+            fp.to_str().unwrap(),
+        ],
+    );
+    assert!(!o.status.success());
+    assert!(String::from_utf8_lossy(&o.stderr).contains("--fields"));
+    assert!(!out.exists());
+}
+
 /// Area of the marked faces (boundary and interior), per marker.
 fn marked_areas(m: &TetMesh) -> BTreeMap<i32, f64> {
     let mut out = BTreeMap::new();

@@ -1,7 +1,9 @@
 //! `tetrefine refine` under `mpirun -n P` (feature `mpi`): rank 0 reads and
 //! partitions, every rank refines its part, the cut moves once for a last
 //! improvement, and the result is written as one `.vtu` piece per rank plus
-//! a `.pvtu` (an `-o *.pvtu`), or gathered into one file of any format.
+//! a `.pvtu` (an `-o *.pvtu`), or gathered into one file of any format,
+//! which rank 0 writes as the serial command does (point locations in the
+//! input it kept, `--parent-map`, `--fields`/`--transfer`, `marked`).
 //! Rank 0 prints the step table of the whole mesh; every file appears only
 //! when every rank succeeded.
 
@@ -48,22 +50,31 @@ struct StatsFile<'a> {
     seconds: f64,
 }
 
-/// Options of the serial command that have no distributed meaning yet.
+/// Options of the serial command that have no distributed meaning yet, and
+/// those a `.pvtu` output cannot carry (a gathered output writes them as the
+/// serial command does, on rank 0).
 fn refuse_serial_only(a: &Args) -> super::CliResult {
     let refused = [
         ("--size", a.size.is_some()),
         ("--size-array", a.size_array.is_some()),
         ("--hsiz", a.hsiz.is_some()),
         ("--hmax", a.hmax.is_some()),
+    ];
+    if let Some((name, _)) = refused.iter().find(|(_, on)| *on) {
+        return Err(format!(
+            "{name} is not available in a distributed run (mpirun or a .pvtu output); run it serially"
+        ));
+    }
+    let gathered_only = [
         ("--parent-map", a.parent_map.is_some()),
         ("--fields", !a.fields.is_empty()),
         ("--transfer", a.transfer),
     ];
-    match refused.iter().find(|(_, on)| *on) {
-        Some((name, _)) => Err(format!(
-            "{name} is not available in a distributed run (mpirun or a .pvtu output); run it serially"
+    match gathered_only.iter().find(|(_, on)| *on) {
+        Some((name, _)) if is_pvtu(&a.output) => Err(format!(
+            "{name} is not available with a .pvtu output (each piece would need the whole input); give -o a single file (e.g. out.vtu), which rank 0 writes gathered with the fields and the parent map"
         )),
-        None => Ok(()),
+        _ => Ok(()),
     }
 }
 
@@ -79,6 +90,7 @@ pub fn run(a: Args) -> super::CliResult {
         ("--stats", a.stats.as_deref()),
         ("--histogram", a.histogram.as_deref()),
         ("--features-out", a.features_out.as_deref()),
+        ("--parent-map", a.parent_map.as_deref()),
     ])?;
     if let Some(f) = &a.features_out {
         tetrefine::PolylineFormat::of(f).map_err(|e| e.to_string())?;
@@ -108,9 +120,9 @@ pub fn run(a: Args) -> super::CliResult {
         Ok(None)
     };
     let loaded = comm.agree(loaded)?;
-    let (input, meta, selection) = match loaded {
-        Some((m, meta, s)) => (Some(m), meta, s),
-        None => (None, Default::default(), None),
+    let (mut input, meta, selection, transfer) = match loaded {
+        Some((m, meta, s, t)) => (Some(m), meta, s, t),
+        None => (None, Default::default(), None, false),
     };
     let mut steps = Vec::new();
     if let Some(m) = &input {
@@ -126,7 +138,10 @@ pub fn run(a: Args) -> super::CliResult {
     }
     let (mut local, first_selection) =
         dist::distribute(&comm, input.as_ref(), selection.as_deref(), n_steps)?;
-    drop(input);
+    if pieces {
+        // A gathered output locates its points in the input on rank 0.
+        input = None;
+    }
     let opts = DistributedOptions {
         refine: RefineOptions {
             boundary: a.boundary,
@@ -134,7 +149,7 @@ pub fn run(a: Args) -> super::CliResult {
             threshold: a.threshold,
             stop_after: a.stop_after,
             selection: None,
-            smooth_refined_only: selection.is_some() && a.smooth == SmoothScope::Refined,
+            smooth_refined_only: first_selection.is_some() && a.smooth == SmoothScope::Refined,
             step_offset: a.step_offset,
             check_each_phase: false,
             effort: a.effort,
@@ -201,7 +216,12 @@ pub fn run(a: Args) -> super::CliResult {
     let written = if pieces {
         write_pieces(&comm, &a.output, &mut local, &last)
     } else {
-        write_union(&a, union.as_mut(), &meta)
+        match (union.as_mut(), &input) {
+            (Some(mesh), Some(input)) => {
+                super::refine::write_output(&a, input, mesh, meta, transfer, selection.as_deref())
+            }
+            _ => Ok(()),
+        }
     };
     comm.agree(written)?;
     let lines = match (&a.features_out, &union) {
@@ -227,10 +247,13 @@ pub fn run(a: Args) -> super::CliResult {
     Ok(())
 }
 
+/// Rank 0's input, its metadata (with `--fields`), the selection and
+/// whether the fields are carried over.
 type Loaded = (
     tetrefine::TetMesh,
     tetrefine::io::MeshMeta,
     Option<Vec<bool>>,
+    bool,
 );
 
 /// Rank 0: the input with its features and the selection.
@@ -238,10 +261,11 @@ fn load_on_root(
     a: &Args,
     strategy: Option<&tetrefine::MarkStrategy>,
 ) -> Result<Option<Loaded>, String> {
-    let (mut input, meta) = super::load_with_meta(&a.input)?;
+    let (mut input, mut meta) = super::load_with_meta(&a.input)?;
+    let transfer = super::refine::load_fields(a, &input, &mut meta)?;
     let selection = selection_of(a, strategy, &input)?;
     super::apply_feature_option(&mut input, &a.features, a.feature_angle, a.interfaces)?;
-    Ok(Some((input, meta, selection)))
+    Ok(Some((input, meta, selection, transfer)))
 }
 
 /// `OUT_r.vtu` beside `OUT.pvtu` for rank `r`.
@@ -301,28 +325,6 @@ fn write_pieces(
             .map_err(|e| e.to_string())?;
     }
     Ok(())
-}
-
-/// Rank 0 writes the gathered union in `-o`'s format (`None` elsewhere).
-fn write_union(
-    a: &Args,
-    union: Option<&mut tetrefine::TetMesh>,
-    meta: &tetrefine::io::MeshMeta,
-) -> Result<(), String> {
-    let Some(mesh) = union else {
-        return Ok(());
-    };
-    let options = tetrefine::io::WriteOptions {
-        msh_format: a.msh_format,
-    };
-    super::write_refined(
-        &a.output,
-        mesh,
-        &[],
-        meta,
-        &options,
-        (Vec::new(), Vec::new()),
-    )
 }
 
 /// Rank 0: `--stats` and `--histogram` of the whole mesh.

@@ -69,7 +69,8 @@ pub struct Args {
     pub effort: tetrefine::Effort,
     /// Hausdorff bound (MMG's -hausd): how far boundary moves may take the
     /// surface from the step's reference surface; default 5 % of the local
-    /// edge length.
+    /// edge length for vertex moves and 15 % of a sliver cap's mean edge
+    /// for its removal.
     #[arg(long)]
     pub hausd: Option<f64>,
     /// Stop each step after this phase: split, flip, boundary-split,
@@ -331,41 +332,7 @@ pub fn run(a: Args) -> super::CliResult {
     }
     let strategy = mark_strategy(&a)?;
     let (mut input, mut meta) = super::load_with_meta(&a.input)?;
-    for f in &a.fields {
-        tetrefine::io::add_sol_fields(f, &mut meta, input.n_points(), input.n_tets())
-            .map_err(|e| e.to_string())?;
-    }
-    let has_fields = !meta.point_fields.is_empty() || !meta.cell_fields.is_empty();
-    if a.transfer && !a.no_transfer && !has_fields {
-        return Err(format!(
-            "--transfer: {} carries no point or cell field (give one with --fields FILE.sol)",
-            a.input.display()
-        ));
-    }
-    let transfer = has_fields && !a.no_transfer;
-    if transfer {
-        let beside = tetrefine::io::fields_beside(&a.output);
-        super::outputs::refuse_shared_paths(&[
-            ("-o", Some(a.output.as_path())),
-            ("--stats", a.stats.as_deref()),
-            ("--histogram", a.histogram.as_deref()),
-            ("--features-out", a.features_out.as_deref()),
-            ("--parent-map", a.parent_map.as_deref()),
-            (
-                "the point fields beside -o",
-                beside.as_ref().map(|b| b.0.as_path()),
-            ),
-            (
-                "the cell fields beside -o",
-                beside.as_ref().map(|b| b.1.as_path()),
-            ),
-        ])?;
-        eprintln!(
-            "transfer: {} point and {} cell fields of the input",
-            meta.point_fields.len(),
-            meta.cell_fields.len()
-        );
-    }
+    let transfer = load_fields(&a, &input, &mut meta)?;
     let selection = selection_of(&a, strategy.as_ref(), &input)?;
     let selected = selection
         .as_ref()
@@ -490,52 +457,13 @@ pub fn run(a: Args) -> super::CliResult {
         )?;
         progress.finish();
     }
-    locate_parents(&input, &mut mesh);
     if let Some(path) = &a.stats {
         let text = serde_json::to_string_pretty(&StatsFile { steps: &steps })
             .map_err(|e| e.to_string())?;
         tetrefine::io::write_atomic(path, |w| std::io::Write::write_all(w, text.as_bytes()))
             .map_err(|e| e.to_string())?;
     }
-    mesh.compact();
-    let is_vtu = tetrefine::io::Format::for_writing(&a.output).map_err(|e| e.to_string())?
-        == tetrefine::io::Format::Vtu;
-    let locations = (transfer || is_vtu || a.parent_map.is_some())
-        .then(|| tetrefine::locate_points(&input, &mesh));
-    if let (Some(path), Some(locs)) = (&a.parent_map, &locations) {
-        super::transfer::write_parent_map(path, &input, &mesh, locs)?;
-    }
-    // Whether the tet descends from a selected input tet (all do without a
-    // selection).
-    let sel = selection.as_deref();
-    let marked = |m: &tetrefine::TetMesh, t: u32| {
-        let p = m.parent(t) as usize;
-        i32::from(sel.is_none_or(|s| s.get(p).copied().unwrap_or(false)))
-    };
-    let options = tetrefine::io::WriteOptions {
-        msh_format: a.msh_format,
-    };
-    // Names and tag lists stay valid through refinement (every child keeps its
-    // parent's region and markers); the fields are carried over or dropped.
-    let (point_fields, cell_fields) = match (&locations, transfer) {
-        (Some(locs), true) => super::transfer::transfer_fields(&input, &mesh, &meta, locs),
-        _ => (Vec::new(), Vec::new()),
-    };
-    let arrays = if is_vtu {
-        super::transfer::vtu_arrays(&input, locations.as_deref(), &point_fields, &cell_fields)
-    } else {
-        (Vec::new(), Vec::new())
-    };
-    meta.point_fields = point_fields;
-    meta.cell_fields = cell_fields;
-    super::write_refined(
-        &a.output,
-        &mut mesh,
-        &[("marked", &marked)],
-        &meta,
-        &options,
-        arrays,
-    )?;
+    write_output(&a, &input, &mut mesh, meta, transfer, selection.as_deref())?;
     if let Some(f) = &a.features_out {
         super::write_feature_lines(f, &mesh)?;
     }
@@ -549,5 +477,109 @@ pub fn run(a: Args) -> super::CliResult {
         mesh.n_tets(),
         t0.elapsed().as_secs_f64()
     );
+    Ok(())
+}
+
+/// Adds `--fields` to the input's `meta`, checks `--transfer` against what
+/// the input carries and the output paths the fields would be written to,
+/// and says what will be carried over. Returns whether fields are
+/// transferred.
+pub(super) fn load_fields(
+    a: &Args,
+    input: &tetrefine::TetMesh,
+    meta: &mut tetrefine::io::MeshMeta,
+) -> Result<bool, String> {
+    for f in &a.fields {
+        tetrefine::io::add_sol_fields(f, meta, input.n_points(), input.n_tets())
+            .map_err(|e| e.to_string())?;
+    }
+    let has_fields = !meta.point_fields.is_empty() || !meta.cell_fields.is_empty();
+    if a.transfer && !a.no_transfer && !has_fields {
+        return Err(format!(
+            "--transfer: {} carries no point or cell field (give one with --fields FILE.sol)",
+            a.input.display()
+        ));
+    }
+    let transfer = has_fields && !a.no_transfer;
+    if transfer {
+        let beside = tetrefine::io::fields_beside(&a.output);
+        super::outputs::refuse_shared_paths(&[
+            ("-o", Some(a.output.as_path())),
+            ("--stats", a.stats.as_deref()),
+            ("--histogram", a.histogram.as_deref()),
+            ("--features-out", a.features_out.as_deref()),
+            ("--parent-map", a.parent_map.as_deref()),
+            (
+                "the point fields beside -o",
+                beside.as_ref().map(|b| b.0.as_path()),
+            ),
+            (
+                "the cell fields beside -o",
+                beside.as_ref().map(|b| b.1.as_path()),
+            ),
+        ])?;
+        eprintln!(
+            "transfer: {} point and {} cell fields of the input",
+            meta.point_fields.len(),
+            meta.cell_fields.len()
+        );
+    }
+    Ok(transfer)
+}
+
+/// Writes the refined `mesh` to `-o` as the serial command does, for it and
+/// for a distributed run gathered on rank 0: `parent` set to the input tet
+/// holding each centroid, the mesh compacted, the point locations in the
+/// input (for `.vtu` arrays, `--parent-map` and the transfer), the input's
+/// fields carried over when `transfer`, and the `marked` array from
+/// `selection` (per input tet).
+pub(super) fn write_output(
+    a: &Args,
+    input: &tetrefine::TetMesh,
+    mesh: &mut tetrefine::TetMesh,
+    mut meta: tetrefine::io::MeshMeta,
+    transfer: bool,
+    selection: Option<&[bool]>,
+) -> super::CliResult {
+    locate_parents(input, mesh);
+    mesh.compact();
+    let is_vtu = tetrefine::io::Format::for_writing(&a.output).map_err(|e| e.to_string())?
+        == tetrefine::io::Format::Vtu;
+    let locations = (transfer || is_vtu || a.parent_map.is_some())
+        .then(|| tetrefine::locate_points(input, mesh));
+    if let (Some(path), Some(locs)) = (&a.parent_map, &locations) {
+        super::transfer::write_parent_map(path, input, mesh, locs)?;
+    }
+    // Whether the tet descends from a selected input tet (all do without a
+    // selection).
+    let sel = selection;
+    let marked = |m: &tetrefine::TetMesh, t: u32| {
+        let p = m.parent(t) as usize;
+        i32::from(sel.is_none_or(|s| s.get(p).copied().unwrap_or(false)))
+    };
+    let options = tetrefine::io::WriteOptions {
+        msh_format: a.msh_format,
+    };
+    // Names and tag lists stay valid through refinement (every child keeps its
+    // parent's region and markers); the fields are carried over or dropped.
+    let (point_fields, cell_fields) = match (&locations, transfer) {
+        (Some(locs), true) => super::transfer::transfer_fields(input, mesh, &meta, locs),
+        _ => (Vec::new(), Vec::new()),
+    };
+    let arrays = if is_vtu {
+        super::transfer::vtu_arrays(input, locations.as_deref(), &point_fields, &cell_fields)
+    } else {
+        (Vec::new(), Vec::new())
+    };
+    meta.point_fields = point_fields;
+    meta.cell_fields = cell_fields;
+    super::write_refined(
+        &a.output,
+        mesh,
+        &[("marked", &marked)],
+        &meta,
+        &options,
+        arrays,
+    )?;
     Ok(())
 }
