@@ -78,6 +78,15 @@ pub struct BoundarySmoothOptions {
     /// `crease_angle` allows flat stars only, 1e-4° or less, as the linear
     /// rule sets it).
     pub flip_edges: bool,
+    /// After the passes, contract boundary edges of the tets below the
+    /// threshold ([`crate::ops::contract_boundary_edge`]) where the fan
+    /// that replaces the merged vertex's faces stays within the Hausdorff
+    /// bound (exactly in their plane when `crease_angle` allows flat stars
+    /// only). Off at every effort: on the shipped meshes it raised only the
+    /// tripod's worst angle after two steps (17.43° → 17.57°) and took the
+    /// ladder's below its input's (5.02° against 5.34° at a 69° feature
+    /// angle, and in adaptive runs).
+    pub contract_edges: bool,
 }
 
 impl Default for BoundarySmoothOptions {
@@ -94,6 +103,7 @@ impl Default for BoundarySmoothOptions {
             crease_angle: 45.0,
             remove_caps: true,
             flip_edges: false,
+            contract_edges: false,
         }
     }
 }

@@ -219,15 +219,15 @@ pub fn improve(mesh: &mut TetMesh, opts: &ImproveOptions) -> ImproveReport {
         }
     }
     let fixed = mesh.fixed_vertices();
-    let mut movable: Vec<bool> = (0..mesh.n_points())
+    // The vertices the caller lets change (`--smooth refined`'s zone).
+    let zone: Vec<bool> = (0..mesh.n_points())
         .map(|v| {
-            !fixed[v]
-                && opts
-                    .movable
-                    .as_ref()
-                    .is_none_or(|m| m.get(v).copied().unwrap_or(v >= first_new_point))
+            opts.movable
+                .as_ref()
+                .is_none_or(|m| m.get(v).copied().unwrap_or(v >= first_new_point))
         })
         .collect();
+    let mut movable: Vec<bool> = (0..mesh.n_points()).map(|v| !fixed[v] && zone[v]).collect();
     drop(fixed);
     let mut tr = Tracker::new(mesh, tet_allowed);
     let mut edges = EdgeRemoval::default();
@@ -247,7 +247,7 @@ pub fn improve(mesh: &mut TetMesh, opts: &ImproveOptions) -> ImproveReport {
         // they took out 5–20 % of the tets and ended lower in the worst
         // angle on four of the seven shipped meshes (two steps).
         if pass > 0 {
-            changed += contract_pass(mesh, &mut tr, &mut movable, opts, &mut report);
+            changed += contract_pass(mesh, &mut tr, &mut movable, None, opts, &mut report);
         }
         changed += smooth_pass(mesh, &mut tr, &movable, opts, &mut report);
         if let Some(s) = &surface {
@@ -259,6 +259,19 @@ pub fn improve(mesh: &mut TetMesh, opts: &ImproveOptions) -> ImproveReport {
     }
     if let Some(b) = &opts.boundary {
         if opts.passes > 0 {
+            // Boundary contractions change the boundary's triangulation, so
+            // they wait until the smoother, whose reference it is, is done;
+            // one more interior pass then settles the balls they changed.
+            let merged = if b.contract_edges {
+                contract_pass(mesh, &mut tr, &mut movable, Some(&zone), opts, &mut report)
+            } else {
+                0
+            };
+            if merged > 0 {
+                edges.pass(mesh, &mut tr, opts, &mut report);
+                contract_pass(mesh, &mut tr, &mut movable, None, opts, &mut report);
+                smooth_pass(mesh, &mut tr, &movable, opts, &mut report);
+            }
             cap_pass(mesh, &mut tr, b, opts, &mut report);
             // Flips go last: before the smoother, a flip's new faces would
             // be its reference surface too, and the smoother undoes them.
@@ -277,11 +290,16 @@ pub fn improve(mesh: &mut TetMesh, opts: &ImproveOptions) -> ImproveReport {
 /// whose short edge joins an interior vertex to one that may not move
 /// (after a step, a new point crowded against the boundary) keeps that
 /// edge through every flip and smoothing move; only the contraction takes
-/// it out. Returns the number of contractions.
+/// it out. With `boundary_zone` (the vertices the caller lets change) the
+/// merged vertices are the fixed ones instead, each on a flat piece of the
+/// boundary ([`crate::ops::contract_flat_boundary_edge`], which refuses
+/// every other kind): a sliver with four boundary corners on a plane.
+/// Returns the number of contractions.
 fn contract_pass(
     mesh: &mut TetMesh,
     tr: &mut Tracker,
     movable: &mut [bool],
+    boundary_zone: Option<&[bool]>,
     opts: &ImproveOptions,
     report: &mut ImproveReport,
 ) -> usize {
@@ -303,7 +321,11 @@ fn contract_pass(
         'edges: for e in order {
             let [i, j] = TET_EDGES[e];
             for (v, u) in [(tv[i], tv[j]), (tv[j], tv[i])] {
-                if !movable[v as usize] {
+                let may = match boundary_zone {
+                    None => movable[v as usize],
+                    Some(z) => z[v as usize] && !movable[v as usize],
+                };
+                if !may {
                     continue;
                 }
                 mesh.ball(v, &mut ball);
@@ -314,7 +336,19 @@ fn contract_pass(
                     .iter()
                     .map(|&b| tr.tq[b as usize])
                     .fold(f64::INFINITY, f64::min);
-                if let Ok(new) = crate::ops::contract_edge(mesh, v, u, beat, &mut scratch) {
+                let done = match (boundary_zone, &opts.boundary) {
+                    (Some(_), Some(b)) => {
+                        let mean_edge = (0..6).map(len).map(f64::sqrt).sum::<f64>() / 6.0;
+                        let limits = BoundaryFlipLimits {
+                            exact: b.crease_angle <= FLAT_ONLY,
+                            hausd: b.hausd.unwrap_or(b.hausd_rel * mean_edge),
+                            crease_angle: b.crease_angle,
+                        };
+                        crate::ops::contract_boundary_edge(mesh, v, u, beat, limits, &mut scratch)
+                    }
+                    _ => crate::ops::contract_edge(mesh, v, u, beat, &mut scratch),
+                };
+                if let Ok(new) = done {
                     tr.grow(mesh.n_tet_slots());
                     for &b in &ball {
                         tr.tq[b as usize] = f64::INFINITY;

@@ -32,9 +32,11 @@
 //! checks the orientation with the exact predicate and the matching before it
 //! touches the mesh.
 
-use super::{replace_cavity_raw, OpError};
+use super::{replace_cavity_raw, BoundaryFlipLimits, OpError};
+use crate::geom::closest::surfaces_within;
 use crate::geom::tet_min_sine;
 use crate::mesh::{TetMesh, NO_ADJ};
+use glam::DVec3;
 
 /// Merges the interior vertex `v` into its neighbour `u` if every tet of the
 /// new configuration is positively oriented and its worst quality (min sine)
@@ -50,6 +52,45 @@ pub fn contract_edge(
     beat: f64,
     ball: &mut Vec<u32>,
 ) -> Result<Vec<u32>, OpError> {
+    contract(mesh, v, u, beat, ball, None)
+}
+
+/// [`contract_edge`] for a vertex `v` on the boundary: `(u, v)` is a
+/// boundary edge, the boundary faces at `v` have one marker (no partition
+/// face), and `v` is on no interface, marked interior face or feature edge
+/// and is no corner. The polygon the boundary faces at `v` form is
+/// re-triangulated as a fan from `u`; the new boundary faces take the
+/// marker. Under `limits.exact` every boundary face at `v` must lie in one
+/// plane (exact `orient3d`), so the fan lies in it and the domain is
+/// unchanged; otherwise no two old faces and no two new ones may meet at
+/// more than `limits.crease_angle`, and the fan must stay within
+/// `limits.hausd` of the old faces and they of it (measured from above as
+/// the boundary cap removal measures it). An interior `v` is contracted as
+/// by [`contract_edge`].
+///
+/// The cones of the argument above over the old boundary faces are left
+/// out (flat, or outside the ball where the surface bends); the others tile
+/// the ball re-bounded by the fan, and a fan triangle that would fold over
+/// makes its tet inverted, which the exact check refuses.
+pub fn contract_boundary_edge(
+    mesh: &mut TetMesh,
+    v: u32,
+    u: u32,
+    beat: f64,
+    limits: BoundaryFlipLimits,
+    ball: &mut Vec<u32>,
+) -> Result<Vec<u32>, OpError> {
+    contract(mesh, v, u, beat, ball, Some(limits))
+}
+
+fn contract(
+    mesh: &mut TetMesh,
+    v: u32,
+    u: u32,
+    beat: f64,
+    ball: &mut Vec<u32>,
+    boundary: Option<BoundaryFlipLimits>,
+) -> Result<Vec<u32>, OpError> {
     if u == v {
         return Err(OpError::NotApplicable("an edge needs two vertices"));
     }
@@ -62,6 +103,9 @@ pub fn contract_edge(
     }
     let region = mesh.region(ball[0]);
     let mut has_edge = false;
+    // Boundary faces at v (flat mode): their corners and their marker.
+    let mut open: Vec<[u32; 3]> = Vec::new();
+    let mut marker = None;
     for &t in ball.iter() {
         let tv = mesh.tet(t);
         has_edge |= tv.contains(&u);
@@ -73,7 +117,18 @@ pub fn contract_edge(
             if tv[f] == v {
                 continue;
             }
-            if h == NO_ADJ || mesh.is_interface_face(t, f) {
+            if h == NO_ADJ && boundary.is_some() {
+                let face = mesh.face_vertices(t, f);
+                let m = mesh.face_marker(face);
+                if m.is_some_and(crate::mesh::partition::is_partition_marker) {
+                    return Err(OpError::NotApplicable("vertex on a partition face"));
+                }
+                if !open.is_empty() && m != marker {
+                    return Err(OpError::NotApplicable("boundary faces of two markers"));
+                }
+                marker = m;
+                open.push(face);
+            } else if h == NO_ADJ || mesh.is_interface_face(t, f) {
                 return Err(OpError::NotApplicable("vertex on a constrained face"));
             }
         }
@@ -83,6 +138,12 @@ pub fn contract_edge(
     }
     if !has_edge {
         return Err(OpError::NotApplicable("no edge between the two vertices"));
+    }
+    if let (Some(limits), false) = (boundary, open.is_empty()) {
+        if !open.iter().any(|f| f.contains(&u)) {
+            return Err(OpError::NotApplicable("not a boundary edge"));
+        }
+        boundary_stays(mesh, &open, v, u, limits)?;
     }
     let mut old = Vec::with_capacity(ball.len());
     let mut new = Vec::with_capacity(ball.len());
@@ -107,11 +168,60 @@ pub fn contract_edge(
     Ok(ids)
 }
 
+/// Whether re-triangulating the boundary faces `open` at `v` as a fan from
+/// `u` keeps the boundary within `limits` (see [`contract_boundary_edge`]).
+fn boundary_stays(
+    mesh: &TetMesh,
+    open: &[[u32; 3]],
+    v: u32,
+    u: u32,
+    limits: BoundaryFlipLimits,
+) -> Result<(), OpError> {
+    let corners = |f: &[u32; 3]| f.map(|x| mesh.point(x));
+    if limits.exact {
+        // Exactly one plane: every corner against the first face.
+        let [a, b, c] = corners(&open[0]);
+        let coplanar = open.iter().flatten().all(|&x| {
+            crate::geom::orient3d_sign(a, b, c, mesh.point(x)) == crate::geom::Orientation::Zero
+        });
+        return if coplanar {
+            Ok(())
+        } else {
+            Err(OpError::NotApplicable("boundary star not flat"))
+        };
+    }
+    let old: Vec<[DVec3; 3]> = open.iter().map(corners).collect();
+    let new: Vec<[DVec3; 3]> = open
+        .iter()
+        .filter(|f| !f.contains(&u))
+        .map(|f| corners(&f.map(|x| if x == v { u } else { x })))
+        .collect();
+    let cos = limits.crease_angle.to_radians().cos();
+    for faces in [&old, &new] {
+        let normals: Vec<DVec3> = faces
+            .iter()
+            .map(|p| (p[1] - p[0]).cross(p[2] - p[0]).normalize())
+            .collect();
+        for (i, a) in normals.iter().enumerate() {
+            // A NaN (a degenerate face) is no number at or above `cos`:
+            // refused.
+            let apart = |b: &DVec3| a.dot(*b).partial_cmp(&cos).is_none_or(|o| o.is_lt());
+            if normals[i + 1..].iter().any(apart) {
+                return Err(OpError::NotApplicable("the boundary there has a crease"));
+            }
+        }
+    }
+    if surfaces_within(&old, &new, limits.hausd) && surfaces_within(&new, &old, limits.hausd) {
+        Ok(())
+    } else {
+        Err(OpError::NotApplicable("beyond the Hausdorff bound"))
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::mesh::MeshData;
-    use glam::DVec3;
 
     /// An octahedron (±1 on each axis) split into eight tets around an
     /// interior point `c`, each tet positively oriented: points ±x, ±y,
@@ -217,5 +327,76 @@ mod tests {
         );
         assert_eq!(m.tet_slots(), &before[..]);
         m.check().unwrap();
+    }
+
+    /// Boundary faces as (corners, marker).
+    fn boundary(m: &TetMesh) -> Vec<([DVec3; 3], Option<i32>)> {
+        let mut out = Vec::new();
+        for t in m.tet_ids() {
+            for f in 0..4 {
+                if m.is_boundary_face(t, f) {
+                    let fv = m.face_vertices(t, f);
+                    out.push((fv.map(|x| m.point(x)), m.face_marker(fv)));
+                }
+            }
+        }
+        out
+    }
+
+    fn area(p: &[DVec3; 3]) -> f64 {
+        0.5 * (p[1] - p[0]).cross(p[2] - p[0]).length()
+    }
+
+    #[test]
+    fn a_face_vertex_of_the_cube_merges_inside_its_face_and_the_domain_stays() {
+        let n = 4;
+        let (mut m, _) = TetMesh::from_data(&crate::mesh::generate::cube_grid(n)).unwrap();
+        let id = |i: usize, j: usize, k: usize| (i + (n + 1) * (j + (n + 1) * k)) as u32;
+        // The bottom face (z = 0) carries marker 7.
+        for (t, f) in m
+            .tet_ids()
+            .flat_map(|t| (0..4).map(move |f| (t, f)))
+            .collect::<Vec<_>>()
+        {
+            let fv = m.face_vertices(t, f);
+            if m.is_boundary_face(t, f) && fv.iter().all(|&x| m.point(x).z == 0.0) {
+                m.set_face_marker(fv, Some(7));
+            }
+        }
+        let before = boundary(&m);
+        let marked = before.iter().filter(|b| b.1 == Some(7)).count();
+        let exact = BoundaryFlipLimits {
+            exact: true,
+            hausd: 0.0,
+            crease_angle: 0.0,
+        };
+        let mut ball = Vec::new();
+        // On a cube edge the star is not flat: refused, exactly or within a
+        // bound (the 90° crease).
+        let bent = BoundaryFlipLimits {
+            exact: false,
+            hausd: 0.1,
+            crease_angle: 45.0,
+        };
+        for limits in [exact, bent] {
+            assert!(matches!(
+                contract_boundary_edge(&mut m, id(2, 0, 0), id(3, 0, 0), -1.0, limits, &mut ball),
+                Err(OpError::NotApplicable(_))
+            ));
+        }
+        let tets = m.n_tets();
+        contract_boundary_edge(&mut m, id(2, 2, 0), id(3, 2, 0), -1.0, exact, &mut ball).unwrap();
+        m.check().unwrap();
+        // The unit cube: volume 1 and boundary area 6; the six faces at the
+        // merged vertex became a fan of four from its neighbour, all marked.
+        assert!((volume(&m) - 1.0).abs() < 1e-12);
+        let after = boundary(&m);
+        assert_eq!(after.len(), before.len() - 2);
+        assert!((after.iter().map(|b| area(&b.0)).sum::<f64>() - 6.0).abs() < 1e-12);
+        assert_eq!(after.iter().filter(|b| b.1 == Some(7)).count(), marked - 2);
+        assert!(after
+            .iter()
+            .all(|b| (b.1 == Some(7)) == b.0.iter().all(|p| p.z == 0.0)));
+        assert!(m.n_tets() < tets);
     }
 }

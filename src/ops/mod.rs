@@ -29,7 +29,7 @@ pub use boundary_flip::{boundary_flip_ring, flip_boundary_edge, BoundaryFlipLimi
 pub use bulk_flip::{flip23_bulk, FlipBatch};
 pub use bulk_split::split14_bulk;
 pub use cap_removal::{is_cap_below, remove_boundary_cap, CapLimits};
-pub use edge_contraction::contract_edge;
+pub use edge_contraction::{contract_boundary_edge, contract_edge};
 pub use edge_removal::{remove_edge, EdgeRing};
 pub use edge_split::split_edge;
 pub use flip23::{flip23, flip23_tets, flip23_valid};

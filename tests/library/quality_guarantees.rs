@@ -463,3 +463,50 @@ fn boundary_flips_keep_the_domain_and_the_worst() {
         assert_eq!(after.boundary_faces, before.boundary_faces, "{name}");
     }
 }
+
+#[test]
+fn boundary_contractions_keep_the_domain_and_the_worst() {
+    let mut fewer_faces = 0;
+    for name in SMALL {
+        let mut m = load(name, Some(45.0));
+        refine_step(
+            &mut m,
+            1,
+            &RefineOptions {
+                boundary: Sqrt3Rule::Linear,
+                effort: tetrefine::Effort::Fast,
+                ..Default::default()
+            },
+        );
+        let before = MeshStats::compute(&m);
+        let worst = checked_worst(&m, name);
+        // One pass (no interior contraction: that waits for a second) with
+        // flat stars only, then the boundary contractions after it.
+        let opts = ImproveOptions {
+            passes: 1,
+            laplacian_threshold: 0.0,
+            edge_threshold: 0.0,
+            boundary: Some(tetrefine::BoundarySmoothOptions {
+                crease_angle: 0.0,
+                remove_caps: false,
+                contract_edges: true,
+                ..Default::default()
+            }),
+            ..Default::default()
+        };
+        improve(&mut m, &opts);
+        let after = MeshStats::compute(&m);
+        assert!(checked_worst(&m, name) >= worst, "{name}: worst fell");
+        assert!(
+            (after.volume - before.volume).abs() <= 1e-12 * before.volume,
+            "{name}: volume {} -> {}",
+            before.volume,
+            after.volume
+        );
+        // A boundary contraction replaces a vertex's k faces by k - 2.
+        assert!(after.boundary_faces <= before.boundary_faces, "{name}");
+        assert_eq!(after.boundary_faces % 2, before.boundary_faces % 2);
+        fewer_faces += usize::from(after.boundary_faces < before.boundary_faces);
+    }
+    assert!(fewer_faces > 0, "no boundary contraction on any mesh");
+}
