@@ -879,13 +879,14 @@ impl Mesh {
         }
     }
 
-    /// Improve the mesh (edge removal, smoothing, boundary moves inside their
-    /// patches and sliver-cap removal; features detected at feature_angle as
-    /// `--features auto` does) — `tetrefine improve`. Returns a new Mesh whose
-    /// `reports` hold one dict (passes, edges_removed, laplacian_moves,
-    /// optimized_moves, surface_moves, line_moves, caps_removed,
-    /// long_edges_split, boundary_flips, edges_contracted; improve alone
-    /// never splits).
+    /// Improve the mesh (edge and multi-face removal, edge contraction,
+    /// smoothing, boundary moves inside their patches and sliver-cap removal;
+    /// features detected at feature_angle as `--features auto` does) —
+    /// `tetrefine improve`. Returns a new Mesh whose `reports` hold one dict
+    /// (passes, edges_removed, laplacian_moves, optimized_moves,
+    /// surface_moves, line_moves, caps_removed, long_edges_split,
+    /// boundary_flips, edges_contracted, faces_removed; improve alone never
+    /// splits).
     ///
     ///   opt_passes     Maximum passes of edge removal + smoothing
     ///                  [--opt-passes] (default 5).

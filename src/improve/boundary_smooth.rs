@@ -82,10 +82,11 @@ pub struct BoundarySmoothOptions {
     /// threshold ([`crate::ops::contract_boundary_edge`]) where the fan
     /// that replaces the merged vertex's faces stays within the Hausdorff
     /// bound (exactly in their plane when `crease_angle` allows flat stars
-    /// only). Off at every effort: on the shipped meshes it raised only the
-    /// tripod's worst angle after two steps (17.43° → 17.57°) and took the
-    /// ladder's below its input's (5.02° against 5.34° at a 69° feature
-    /// angle, and in adaptive runs).
+    /// only). On by default: with multi-face removal in the passes it
+    /// lifts the slivers at boundary points crowded against a corner (the
+    /// ladder at a 69° feature angle, two steps: 4.45° without, 6.81° with;
+    /// input 5.34°) and mmg_cube's worst after two steps (13.97° → 17.48°),
+    /// and lowers no shipped mesh's worst by more than 0.02°.
     pub contract_edges: bool,
 }
 
@@ -103,7 +104,7 @@ impl Default for BoundarySmoothOptions {
             crease_angle: 45.0,
             remove_caps: true,
             flip_edges: false,
-            contract_edges: false,
+            contract_edges: true,
         }
     }
 }

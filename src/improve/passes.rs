@@ -1,12 +1,14 @@
 //! The `optimize` phase (the √3 paper, §3.2, steps 6–7): passes of interior edge
-//! removal where it raises the worst tet of the edge's ring, then vertex
-//! smoothing where a vertex's worst tet is below a threshold — Laplacian
-//! first, kept only if it helps, then optimization-based smoothing —
-//! repeated until a pass changes nothing or the pass budget is spent.
+//! removal where it raises the worst tet of the edge's ring (on a ring of
+//! three a 3-2 flip, of four a 4-4 flip), multi-face removal at the tets
+//! it left bad (one face: a 2-3 flip), then vertex smoothing where a
+//! vertex's worst tet is below a threshold — Laplacian first, kept only if
+//! it helps, then optimization-based smoothing — repeated until a pass
+//! changes nothing or the pass budget is spent.
 //!
 //! Boundary vertices, vertices on region interfaces or marked faces, feature
 //! edges, corners and required vertices never move, and only interior edges
-//! (closed rings inside one region) are removed, so the domain, its regions
+//! and faces (inside one region) are removed, so the domain, its regions
 //! and its tags are untouched.
 
 use super::boundary_smooth::FLAT_ONLY;
@@ -112,6 +114,9 @@ pub struct ImproveReport {
     /// Short edges contracted, an interior vertex merged into a neighbour
     /// ([`crate::ops::contract_edge`]).
     pub edges_contracted: usize,
+    /// Multi-face removals ([`crate::ops::remove_faces`]; one face is a 2-3
+    /// flip).
+    pub faces_removed: usize,
 }
 
 impl ImproveReport {
@@ -127,6 +132,7 @@ impl ImproveReport {
         self.long_edges_split += other.long_edges_split;
         self.boundary_flips += other.boundary_flips;
         self.edges_contracted += other.edges_contracted;
+        self.faces_removed += other.faces_removed;
     }
 }
 
@@ -243,6 +249,7 @@ pub fn improve(mesh: &mut TetMesh, opts: &ImproveOptions) -> ImproveReport {
     for pass in 0..opts.passes {
         report.passes += 1;
         let mut changed = edges.pass(mesh, &mut tr, opts, &mut report);
+        changed += face_pass(mesh, &mut tr, &edges.examined, &movable, opts, &mut report);
         if pass >= CONTRACT_FROM_PASS {
             changed += contract_pass(mesh, &mut tr, &mut movable, None, opts, &mut report);
         }
@@ -278,6 +285,59 @@ pub fn improve(mesh: &mut TetMesh, opts: &ImproveOptions) -> ImproveReport {
         }
     }
     report
+}
+
+/// Multi-face removals ([`crate::ops::remove_faces`]) at the faces of the
+/// `candidates` (those the edge removal pass examined) still below
+/// `opts.edge_threshold` after it, where the
+/// worst new tet beats the tet, over at most `opts.max_ring` faces (the
+/// removal that undoes an edge removal of that ring). One sweep in slot
+/// order. Returns the number of removals.
+fn face_pass(
+    mesh: &mut TetMesh,
+    tr: &mut Tracker,
+    candidates: &[u32],
+    movable: &[bool],
+    opts: &ImproveOptions,
+    report: &mut ImproveReport,
+) -> usize {
+    let mut removed = 0;
+    for &t in candidates {
+        for f in 0..4 {
+            if !mesh.is_alive(t) || tr.tq[t as usize] >= opts.edge_threshold {
+                break;
+            }
+            // The new edge joins the two apexes; not a chord between two
+            // vertices that may not move (see `face_pass`).
+            let h = mesh.adj(t)[f];
+            if h == crate::mesh::NO_ADJ
+                || (!movable[mesh.tet(t)[f] as usize]
+                    && !movable[mesh.tet(h >> 2)[(h & 3) as usize] as usize])
+            {
+                continue;
+            }
+            // Strictly better by more than the rounding of `tet_min_sine`,
+            // as for edge removal, so that passes cannot cycle.
+            let beat = tr.tq[t as usize] + 1e-12;
+            let allowed = |x: u32| tr.is_allowed(x);
+            let Ok(r) = crate::ops::remove_faces(mesh, t, f, beat, opts.max_ring, &allowed) else {
+                continue;
+            };
+            tr.grow(mesh.n_tet_slots());
+            for &x in &r.removed {
+                tr.tq[x as usize] = f64::INFINITY;
+            }
+            for &n in &r.created {
+                if let Some(a) = &mut tr.allowed {
+                    a[n as usize] = true;
+                }
+                tr.set(mesh, n, tet_min_sine(&mesh.tet_points(n)));
+            }
+            removed += 1;
+        }
+    }
+    report.faces_removed += removed;
+    removed
 }
 
 /// The first pass (counted from 0) with interior edge contractions: the
@@ -597,6 +657,9 @@ struct EdgeRemoval {
     born: Vec<bool>,
     /// Per point: a vertex of a cavity re-triangulated in this pass.
     touched: Vec<bool>,
+    /// The candidate tets of the last pass (dirty and below the edge
+    /// threshold), for the face removals that follow it.
+    examined: Vec<u32>,
 }
 
 /// Per-thread buffers of the edge search.
@@ -694,7 +757,7 @@ impl EdgeRemoval {
         let mut retried: FastHashSet<EdgeKey> = FastHashSet::default();
         let mut removed = 0;
         let mut scratch = EdgeScratch::default();
-        for t in candidates {
+        for &t in &candidates {
             if !mesh.is_alive(t) || tr.tq[t as usize] >= opts.edge_threshold {
                 continue;
             }
@@ -760,7 +823,10 @@ impl EdgeRemoval {
         report.edges_removed += removed;
         // Per-slot and per-point buffers are not kept between passes (the
         // smoothing half needs the room).
-        *self = EdgeRemoval::default();
+        *self = EdgeRemoval {
+            examined: candidates,
+            ..EdgeRemoval::default()
+        };
         removed
     }
 }

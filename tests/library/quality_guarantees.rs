@@ -418,21 +418,31 @@ fn linear_boundary_moves_keep_region_volumes_of_boxes() {
 
 /// Boundary 2-2 flips in `improve` (`BoundarySmoothOptions::flip_edges`,
 /// off by default: measured below): on every small mesh after one fast
-/// step, with only exactly coplanar faces allowed (crease angle 0), flips
+/// step (the raw √3 step), with only exactly coplanar faces allowed (crease angle 0), flips
 /// happen, never lower the worst angle, and keep the domain exactly: its
 /// volume, and the count of boundary faces (a flip trades two for two).
+/// One √3 step of `name` (features at 45°) with no optimize phase, so
+/// that what an operation under test finds to do does not depend on the
+/// passes.
+fn raw_step(name: &str, rule: Sqrt3Rule) -> TetMesh {
+    let mut m = load(name, Some(45.0));
+    refine_step(
+        &mut m,
+        1,
+        &RefineOptions {
+            boundary: rule,
+            effort: tetrefine::Effort::Fast,
+            opt_passes: 0,
+            ..Default::default()
+        },
+    );
+    m
+}
+
 #[test]
 fn boundary_flips_keep_the_domain_and_the_worst() {
     for name in SMALL {
-        let mut m = load(name, Some(45.0));
-        refine_step(
-            &mut m,
-            1,
-            &RefineOptions {
-                effort: tetrefine::Effort::Fast,
-                ..Default::default()
-            },
-        );
+        let mut m = raw_step(name, Sqrt3Rule::Interpolating);
         let before = MeshStats::compute(&m);
         let worst = checked_worst(&m, name);
         // One pass with the passes' own bars at (about) zero: only the
@@ -468,16 +478,7 @@ fn boundary_flips_keep_the_domain_and_the_worst() {
 fn boundary_contractions_keep_the_domain_and_the_worst() {
     let mut fewer_faces = 0;
     for name in SMALL {
-        let mut m = load(name, Some(45.0));
-        refine_step(
-            &mut m,
-            1,
-            &RefineOptions {
-                boundary: Sqrt3Rule::Linear,
-                effort: tetrefine::Effort::Fast,
-                ..Default::default()
-            },
-        );
+        let mut m = raw_step(name, Sqrt3Rule::Linear);
         let before = MeshStats::compute(&m);
         let worst = checked_worst(&m, name);
         // One pass (no interior contraction: that waits for a second) with
@@ -509,4 +510,48 @@ fn boundary_contractions_keep_the_domain_and_the_worst() {
         fewer_faces += usize::from(after.boundary_faces < before.boundary_faces);
     }
     assert!(fewer_faces > 0, "no boundary contraction on any mesh");
+}
+
+/// Multi-face removals (issue 14, Deliver 3): on every small mesh after
+/// one fast step, a pass of interior edge and face removal with every
+/// vertex fixed (smoothing bars at zero, boundary off) removes faces,
+/// never lowers the worst angle, and keeps every region's volume and the
+/// boundary's faces (the removals are interior and one region each).
+#[test]
+fn face_removals_keep_the_regions_and_the_worst() {
+    for name in SMALL {
+        let mut m = load(name, Some(45.0));
+        refine_step(
+            &mut m,
+            1,
+            &RefineOptions {
+                effort: tetrefine::Effort::Fast,
+                ..Default::default()
+            },
+        );
+        let before = MeshStats::compute(&m);
+        let volumes = region_volumes(&m);
+        let worst = checked_worst(&m, name);
+        let opts = ImproveOptions {
+            passes: 1,
+            threshold: 1e-9,
+            laplacian_threshold: 0.0,
+            boundary: None,
+            ..Default::default()
+        };
+        let r = improve(&mut m, &opts);
+        assert!(r.faces_removed > 0, "{name}: no face removed");
+        assert_eq!((r.laplacian_moves, r.optimized_moves), (0, 0));
+        assert!(checked_worst(&m, name) >= worst, "{name}: worst fell");
+        let after = MeshStats::compute(&m);
+        assert_eq!(after.boundary_faces, before.boundary_faces, "{name}");
+        assert_eq!(after.nodes, before.nodes, "{name}: points come or go");
+        for ((ra, va), (rb, vb)) in volumes.iter().zip(region_volumes(&m)) {
+            assert_eq!(*ra, rb);
+            assert!(
+                (va - vb).abs() <= 1e-12 * va,
+                "{name} region {ra}: {va} -> {vb}"
+            );
+        }
+    }
 }
