@@ -24,6 +24,7 @@ use crate::mesh::fasthash::{FastHashMap, FastHashSet};
 use crate::mesh::{edge_key, EdgeKey, TetMesh};
 use crate::ops::edge_removal::{apply_ring_triangulation, RingTriangulation};
 use crate::ops::edge_removal::{best_ring_triangulation_above, RingScratch};
+use crate::ops::face_removal::{apply_face_removal, plan_face_removal, FacePlan};
 use crate::ops::EdgeRing;
 use crate::ops::{boundary_flip_ring, flip_boundary_edge, BoundaryFlipLimits, TetsAtVertex};
 use crate::ops::{is_cap_below, remove_boundary_cap, CapLimits};
@@ -289,10 +290,23 @@ pub fn improve(mesh: &mut TetMesh, opts: &ImproveOptions) -> ImproveReport {
 
 /// Multi-face removals ([`crate::ops::remove_faces`]) at the faces of the
 /// `candidates` (those the edge removal pass examined) still below
-/// `opts.edge_threshold` after it, where the
-/// worst new tet beats the tet, over at most `opts.max_ring` faces (the
-/// removal that undoes an edge removal of that ring). One sweep in slot
-/// order. Returns the number of removals.
+/// `opts.edge_threshold` after it, where the worst new tet beats the tet,
+/// over at most `opts.max_ring` faces (the removal that undoes an edge
+/// removal of that ring). A face whose two apexes may both not move is
+/// left: the new edge would be a chord between two boundary points, which
+/// left slivers at the ladder's corners that nothing lifted. Returns the
+/// number of removals.
+///
+/// The result is the one of a sequential sweep in candidate order over
+/// the faces of each slot in local order (a slot that a removal re-used
+/// for a new tet is tried on at its next face). The
+/// search runs in parallel on the mesh as it stands; a removal changes
+/// only tets whose vertices are all in its cavity, and every tet a search
+/// at a face of `t` reads holds one of that face's apexes: the vertex of
+/// `t` opposite it or the one across it. So while none of these eight
+/// vertices lies in a cavity re-made earlier in the sweep, the search
+/// result of `t` (a plan, or none) is the sequential one; otherwise `t` is
+/// searched again on the mesh as it is then.
 fn face_pass(
     mesh: &mut TetMesh,
     tr: &mut Tracker,
@@ -301,43 +315,91 @@ fn face_pass(
     opts: &ImproveOptions,
     report: &mut ImproveReport,
 ) -> usize {
+    let found: Vec<Option<(usize, FacePlan)>> = {
+        let (mesh, tr) = (&*mesh, &*tr);
+        candidates
+            .par_iter()
+            .with_min_len(256)
+            .map(|&t| first_face_plan(mesh, tr, t, 0, movable, opts))
+            .collect()
+    };
+    let mut touched = vec![false; mesh.n_points()];
     let mut removed = 0;
-    for &t in candidates {
-        for f in 0..4 {
-            if !mesh.is_alive(t) || tr.tq[t as usize] >= opts.edge_threshold {
-                break;
-            }
-            // The new edge joins the two apexes; not a chord between two
-            // vertices that may not move (see `face_pass`).
+    for (&t, plan) in candidates.iter().zip(found) {
+        if !mesh.is_alive(t) || tr.tq[t as usize] >= opts.edge_threshold {
+            continue;
+        }
+        let stale = (0..4).any(|f| {
             let h = mesh.adj(t)[f];
-            if h == crate::mesh::NO_ADJ
-                || (!movable[mesh.tet(t)[f] as usize]
-                    && !movable[mesh.tet(h >> 2)[(h & 3) as usize] as usize])
-            {
-                continue;
-            }
-            // Strictly better by more than the rounding of `tet_min_sine`,
-            // as for edge removal, so that passes cannot cycle.
-            let beat = tr.tq[t as usize] + 1e-12;
-            let allowed = |x: u32| tr.is_allowed(x);
-            let Ok(r) = crate::ops::remove_faces(mesh, t, f, beat, opts.max_ring, &allowed) else {
-                continue;
-            };
-            tr.grow(mesh.n_tet_slots());
-            for &x in &r.removed {
-                tr.tq[x as usize] = f64::INFINITY;
-            }
-            for &n in &r.created {
-                if let Some(a) = &mut tr.allowed {
-                    a[n as usize] = true;
+            touched[mesh.tet(t)[f] as usize]
+                || (h != crate::mesh::NO_ADJ
+                    && touched[mesh.tet(h >> 2)[(h & 3) as usize] as usize])
+        });
+        let mut plan = if stale {
+            first_face_plan(mesh, tr, t, 0, movable, opts)
+        } else {
+            plan
+        };
+        while let Some((f, p)) = plan {
+            debug_assert!(p.is_current(mesh));
+            match apply_face_removal(mesh, &p) {
+                Ok(r) => {
+                    tr.grow(mesh.n_tet_slots());
+                    for &x in &r.removed {
+                        tr.tq[x as usize] = f64::INFINITY;
+                    }
+                    for &n in &r.created {
+                        if let Some(a) = &mut tr.allowed {
+                            a[n as usize] = true;
+                        }
+                        tr.set(mesh, n, tet_min_sine(&mesh.tet_points(n)));
+                        for v in mesh.tet(n) {
+                            touched[v as usize] = true;
+                        }
+                    }
+                    removed += 1;
+                    // The sweep goes on at the next face of slot `t`, which
+                    // the removal may have re-used for one of its new tets.
+                    plan = if mesh.is_alive(t) && tr.tq[t as usize] < opts.edge_threshold {
+                        first_face_plan(mesh, tr, t, f + 1, movable, opts)
+                    } else {
+                        None
+                    };
                 }
-                tr.set(mesh, n, tet_min_sine(&mesh.tet_points(n)));
+                Err(_) => plan = first_face_plan(mesh, tr, t, f + 1, movable, opts),
             }
-            removed += 1;
         }
     }
     report.faces_removed += removed;
     removed
+}
+
+/// The first face of `t` from local face `from` on with a multi-face
+/// removal that beats `t` (see [`face_pass`]), and its plan.
+fn first_face_plan(
+    mesh: &TetMesh,
+    tr: &Tracker,
+    t: u32,
+    from: usize,
+    movable: &[bool],
+    opts: &ImproveOptions,
+) -> Option<(usize, FacePlan)> {
+    // Strictly better by more than the rounding of `tet_min_sine`, as for
+    // edge removal, so that passes cannot cycle.
+    let beat = tr.tq[t as usize] + 1e-12;
+    let allowed = |x: u32| tr.is_allowed(x);
+    (from..4).find_map(|f| {
+        let h = mesh.adj(t)[f];
+        if h == crate::mesh::NO_ADJ
+            || (!movable[mesh.tet(t)[f] as usize]
+                && !movable[mesh.tet(h >> 2)[(h & 3) as usize] as usize])
+        {
+            return None;
+        }
+        plan_face_removal(mesh, t, f, beat, opts.max_ring, &allowed)
+            .ok()
+            .map(|p| (f, p))
+    })
 }
 
 /// The first pass (counted from 0) with interior edge contractions: the

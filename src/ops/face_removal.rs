@@ -82,8 +82,8 @@ pub struct FaceRemoval {
 /// regions, or marked), an edge `u`–`w` already in the mesh, no subtree
 /// whose new tets are all positive and beat `beat`
 /// ([`OpError::NoImprovement`]; [`OpError::WouldInvert`] when `beat` is
-/// −∞). Faces across feature edges or
-/// constrained faces are never grown into.
+/// −∞). Faces across feature edges or constrained faces are never grown
+/// into.
 pub fn remove_faces(
     mesh: &mut TetMesh,
     t: u32,
@@ -92,6 +92,45 @@ pub fn remove_faces(
     max_faces: usize,
     allowed: &dyn Fn(u32) -> bool,
 ) -> Result<FaceRemoval, OpError> {
+    let plan = plan_face_removal(mesh, t, f, beat, max_faces, allowed)?;
+    apply_face_removal(mesh, &plan)
+}
+
+/// A multi-face removal found on the mesh as it stood
+/// ([`plan_face_removal`]), to be applied by [`apply_face_removal`].
+#[derive(Clone, Debug)]
+pub(crate) struct FacePlan {
+    /// The apexes, ends of the new edge.
+    u: u32,
+    w: u32,
+    /// The tets that go, each with its slot generation when planned.
+    old: Vec<(u32, u32)>,
+    /// The new tets.
+    new: Vec<[u32; 4]>,
+}
+
+impl FacePlan {
+    /// Whether every tet of the cavity is still the one planned on (no
+    /// operation since has freed or re-used its slot).
+    pub(crate) fn is_current(&self, mesh: &TetMesh) -> bool {
+        self.old
+            .iter()
+            .all(|&(t, g)| mesh.is_alive(t) && mesh.generation(t) == g)
+    }
+}
+
+/// The search half of [`remove_faces`]: the best removal at face `f` of
+/// `t` on the mesh as it stands, without changing it. The edge `u`–`w` is
+/// checked when the plan is applied, since a removal made in between may
+/// create it.
+pub(crate) fn plan_face_removal(
+    mesh: &TetMesh,
+    t: u32,
+    f: usize,
+    beat: f64,
+    max_faces: usize,
+    allowed: &dyn Fn(u32) -> bool,
+) -> Result<FacePlan, OpError> {
     let h = mesh.adj(t)[f];
     if h == NO_ADJ {
         return Err(OpError::NotApplicable("boundary face"));
@@ -109,14 +148,13 @@ pub fn remove_faces(
     let w = mesh.tet(tw)[(h & 3) as usize];
     let nodes = grow(mesh, u, w, t, tw, face, max_faces.max(1), allowed);
     let (pu, pw) = (mesh.point(u), mesh.point(w));
-    // Quality of the new tet of side k of node i, or −∞ if it does not beat
-    // the bar (the exact predicate only runs on tets that do).
-    let bar = beat;
+    // Quality of the new tet of side k of a node, or −∞ if it does not
+    // beat the bar (the exact predicate only runs on tets that do).
     let side_q = |n: &Node, k: usize| -> f64 {
         let (a, b) = (n.face[k], n.face[(k + 1) % 3]);
         let p = [pu, mesh.point(a), mesh.point(b), pw];
         let q = tet_min_sine(&p);
-        if q.is_nan() || q <= bar || !is_positive(&p) {
+        if q.is_nan() || q <= beat || !is_positive(&p) {
             f64::NEG_INFINITY
         } else {
             q
@@ -152,19 +190,13 @@ pub fn remove_faces(
             OpError::NoImprovement
         });
     }
-    // The new edge must not exist yet.
-    let mut ball = Vec::new();
-    mesh.ball(u, &mut ball);
-    if ball.iter().any(|&b| mesh.tet(b).contains(&w)) {
-        return Err(OpError::NotApplicable("the apexes already share an edge"));
-    }
     let mut old = Vec::new();
     let mut new = Vec::new();
     let mut stack = vec![0usize];
     while let Some(i) = stack.pop() {
         let n = &nodes[i];
-        old.push(n.tu);
-        old.push(n.tw);
+        old.push((n.tu, mesh.generation(n.tu)));
+        old.push((n.tw, mesh.generation(n.tw)));
         for (k, &deeper) in go_on[i].iter().enumerate() {
             if k == n.up {
                 continue;
@@ -176,11 +208,27 @@ pub fn remove_faces(
             }
         }
     }
-    let faces = old.len() / 2;
-    debug_assert_eq!(new.len(), faces + 2);
-    let created = replace_cavity(mesh, &old, &new)?;
+    debug_assert_eq!(new.len(), old.len() / 2 + 2);
+    Ok(FacePlan { u, w, old, new })
+}
+
+/// Applies a plan whose cavity is current ([`FacePlan::is_current`]):
+/// refused if the edge `u`–`w` exists by now, or by the checks of
+/// [`replace_cavity`].
+pub(crate) fn apply_face_removal(
+    mesh: &mut TetMesh,
+    plan: &FacePlan,
+) -> Result<FaceRemoval, OpError> {
+    debug_assert!(plan.is_current(mesh));
+    let mut ball = Vec::new();
+    mesh.ball(plan.u, &mut ball);
+    if ball.iter().any(|&b| mesh.tet(b).contains(&plan.w)) {
+        return Err(OpError::NotApplicable("the apexes already share an edge"));
+    }
+    let old: Vec<u32> = plan.old.iter().map(|&(t, _)| t).collect();
+    let created = replace_cavity(mesh, &old, &plan.new)?;
     Ok(FaceRemoval {
-        faces,
+        faces: old.len() / 2,
         removed: old,
         created,
     })

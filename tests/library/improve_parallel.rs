@@ -98,6 +98,8 @@ fn improve_is_thread_independent_and_never_inverts() {
     let (three, r3) = improve_with_threads(&mesh, 3);
     assert_eq!(r1, r3);
     assert!(r1.laplacian_moves + r1.optimized_moves > 0, "{r1:?}");
+    // The face sweep's parallel search is exercised too.
+    assert!(r1.faces_removed > 0, "{r1:?}");
     assert_eq!(one.points(), three.points());
     assert_eq!(one.tet_slots(), three.tet_slots());
     for threads in [2, 4] {
