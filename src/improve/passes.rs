@@ -384,6 +384,10 @@ fn first_face_plan(
     movable: &[bool],
     opts: &ImproveOptions,
 ) -> Option<(usize, FacePlan)> {
+    // A candidate the edge pass removed (its slot free) or lifted.
+    if !mesh.is_alive(t) || tr.tq[t as usize] >= opts.edge_threshold {
+        return None;
+    }
     // Strictly better by more than the rounding of `tet_min_sine`, as for
     // edge removal, so that passes cannot cycle.
     let beat = tr.tq[t as usize] + 1e-12;
