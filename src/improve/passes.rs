@@ -195,6 +195,21 @@ impl Tracker {
         }
     }
 
+    /// Records that an operation replaced the tets `removed` by `created`:
+    /// the freed slots' qualities go, the new tets are allowed and recorded.
+    fn replaced(&mut self, mesh: &TetMesh, removed: &[u32], created: &[u32]) {
+        self.grow(mesh.n_tet_slots());
+        for &x in removed {
+            self.tq[x as usize] = f64::INFINITY;
+        }
+        for &n in created {
+            if let Some(a) = &mut self.allowed {
+                a[n as usize] = true;
+            }
+            self.set(mesh, n, tet_min_sine(&mesh.tet_points(n)));
+        }
+    }
+
     fn is_allowed(&self, t: u32) -> bool {
         self.allowed
             .as_ref()
@@ -344,15 +359,8 @@ fn face_pass(
             debug_assert!(p.is_current(mesh));
             match apply_face_removal(mesh, &p) {
                 Ok(r) => {
-                    tr.grow(mesh.n_tet_slots());
-                    for &x in &r.removed {
-                        tr.tq[x as usize] = f64::INFINITY;
-                    }
+                    tr.replaced(mesh, &r.removed, &r.created);
                     for &n in &r.created {
-                        if let Some(a) = &mut tr.allowed {
-                            a[n as usize] = true;
-                        }
-                        tr.set(mesh, n, tet_min_sine(&mesh.tet_points(n)));
                         for v in mesh.tet(n) {
                             touched[v as usize] = true;
                         }
@@ -482,16 +490,7 @@ fn contract_pass(
                     _ => crate::ops::contract_edge(mesh, v, u, beat, &mut scratch),
                 };
                 if let Ok(new) = done {
-                    tr.grow(mesh.n_tet_slots());
-                    for &b in &ball {
-                        tr.tq[b as usize] = f64::INFINITY;
-                    }
-                    for n in new {
-                        if let Some(a) = &mut tr.allowed {
-                            a[n as usize] = true;
-                        }
-                        tr.set(mesh, n, tet_min_sine(&mesh.tet_points(n)));
-                    }
+                    tr.replaced(mesh, &ball, &new);
                     movable[v as usize] = false;
                     contracted += 1;
                     break 'edges;
@@ -563,16 +562,7 @@ fn boundary_flip_pass(
                     .fold(f64::INFINITY, f64::min);
                 let old = ring.tets.clone();
                 if let Ok(new) = flip_boundary_edge(mesh, t, e, limits, beat, &mut counts) {
-                    tr.grow(mesh.n_tet_slots());
-                    for u in old {
-                        tr.tq[u as usize] = f64::INFINITY;
-                    }
-                    for u in new {
-                        if let Some(a) = &mut tr.allowed {
-                            a[u as usize] = true;
-                        }
-                        tr.set(mesh, u, tet_min_sine(&mesh.tet_points(u)));
-                    }
+                    tr.replaced(mesh, &old, &new);
                     flipped += 1;
                     break 'faces;
                 }
