@@ -7,6 +7,7 @@ use mpi::datatype::{Partition, PartitionMut};
 use mpi::topology::SimpleCommunicator;
 use mpi::traits::*;
 use mpi::Count;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 /// A communicator with its rank and size.
 pub struct Comm {
@@ -20,6 +21,15 @@ pub struct Comm {
 /// What a rank that did not fail reports when another one did: its own
 /// message is printed by the failing rank.
 pub const OTHER_RANK_FAILED: &str = "another rank failed (its message is above)";
+
+/// Set once [`Comm::agree`] has printed this rank's own failure.
+static FAILURE_PRINTED: AtomicBool = AtomicBool::new(false);
+
+/// Whether [`Comm::agree`] already printed this rank's failure to stderr
+/// (the caller's top level then need not print it again).
+pub fn failure_printed() -> bool {
+    FAILURE_PRINTED.load(Ordering::Relaxed)
+}
 
 impl Comm {
     /// Wraps `world`.
@@ -130,7 +140,17 @@ impl Comm {
     /// failing ones their own message, the others [`OTHER_RANK_FAILED`]).
     /// A collective, so no rank goes on into a later collective alone (which
     /// would hang).
+    ///
+    /// A failing rank prints `error: <its message>` to stderr *before* the
+    /// reduction: no rank can leave the reduction before every rank entered
+    /// it, so the message is written before any rank exits and mpirun, which
+    /// ends the job at the first non-zero exit, cannot cut it off.
+    /// [`failure_printed`] tells the caller it was printed.
     pub fn agree<T>(&self, local: Result<T, String>) -> Result<T, String> {
+        if let Err(e) = &local {
+            eprintln!("error: {e}");
+            FAILURE_PRINTED.store(true, Ordering::Relaxed);
+        }
         let failed = u64::from(local.is_err());
         let any = self.sum(&[failed])[0];
         match local {

@@ -34,7 +34,7 @@ mod cut;
 mod part;
 mod partition;
 
-pub use comm::{Comm, OTHER_RANK_FAILED};
+pub use comm::{failure_printed, Comm, OTHER_RANK_FAILED};
 pub use cut::{census, global_point_ids, global_stats, Census};
 pub use part::{MarkerSlots, Part};
 pub use partition::partition_dual_graph;

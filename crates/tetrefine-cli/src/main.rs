@@ -52,7 +52,15 @@ fn main() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {e}");
+            // A distributed run's failing rank printed its message before
+            // the ranks parted (see `Comm::agree`).
+            #[cfg(feature = "mpi")]
+            let printed = tetrefine::distributed::failure_printed();
+            #[cfg(not(feature = "mpi"))]
+            let printed = false;
+            if !printed {
+                eprintln!("error: {e}");
+            }
             ExitCode::FAILURE
         }
     }
