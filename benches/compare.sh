@@ -71,6 +71,23 @@ T=${CARGO_TARGET_DIR:-$ROOT/target}/release/tetrefine
 [ -x "$T" ] || { echo "error: $T was not built" >&2; exit 1; }
 
 # ---- helpers ----------------------------------------------------------------
+# other NAME CMD...: as `run`, but another tool's failure (TetGen 1.5 asserts
+# on some inputs) leaves a $WORK/NAME.failed marker, a "failed" row in the
+# table and the other tools running; returns 1.
+other() {
+    local name=$1
+    shift
+    say "$name: $*"
+    echo "$*" >"$WORK/$name.cmd"
+    rm -f "$WORK/$name.failed"
+    if ! /usr/bin/time -v -o "$WORK/$name.time" "$@" >"$WORK/$name.log" 2>&1; then
+        say "$name failed; see $WORK/$name.log"
+        tail -2 "$WORK/$name.log" >&2
+        touch "$WORK/$name.failed"
+        return 1
+    fi
+}
+
 # run NAME CMD...: time CMD, log in $WORK/NAME.{log,time}.
 run() {
     local name=$1
@@ -121,7 +138,7 @@ within10() {
 A=$("$PY" -c "import sys; print('%.6g' % (2*$VOL/$TARGET))")
 for attempt in 1 2 3; do
     rm -f "$WORK"/in.1.*
-    run tetgen tetgen "-rqQa$A" "$WORK/in.node"
+    other tetgen tetgen "-rqQa$A" "$WORK/in.node" || break
     score tetgen "$WORK/in.1.node"
     COUNT=$(json "$WORK/tetgen.quality.json" "d['tets']")
     within10 "$COUNT" && break
@@ -129,8 +146,8 @@ for attempt in 1 2 3; do
 done
 
 # ---- MMG3D -optim (quality optimization at the input's own sizes) -----------
-run mmg_optim "$MMG" -v 0 -optim "$WORK/in.mesh" -out "$WORK/mmg_optim.mesh"
-score mmg_optim "$WORK/mmg_optim.mesh"
+other mmg_optim "$MMG" -v 0 -optim "$WORK/in.mesh" -out "$WORK/mmg_optim.mesh" &&
+    score mmg_optim "$WORK/mmg_optim.mesh"
 
 # ---- MMG3D -hsiz (uniform size for a similar count) --------------------------
 # MMG's tets at size h average about 0.094 h³ (measured on mmg_tinyBoxt).
@@ -141,7 +158,8 @@ score mmg_optim "$WORK/mmg_optim.mesh"
 H=$("$PY" -c "print('%.6g' % (($VOL/(0.094*$TARGET))**(1/3)))")
 for attempt in 1 2 3; do
     HAUSD=$("$PY" -c "print('%.6g' % ($H/4))")
-    run mmg_hsiz "$MMG" -v 0 -hsiz "$H" -hausd "$HAUSD" "$WORK/in.mesh" -out "$WORK/mmg_hsiz.mesh"
+    other mmg_hsiz "$MMG" -v 0 -hsiz "$H" -hausd "$HAUSD" "$WORK/in.mesh" -out "$WORK/mmg_hsiz.mesh" ||
+        break
     score mmg_hsiz "$WORK/mmg_hsiz.mesh"
     COUNT=$(json "$WORK/mmg_hsiz.quality.json" "d['tets']")
     within10 "$COUNT" && break
@@ -182,6 +200,9 @@ print(f"Input: `{os.path.basename(path)}`, {n_in:,} tets.\n")
 print("| tool | seconds | output tets | output tets/s | min dihedral worst / avg (°) | max dihedral worst (°) | peak memory (MB) |")
 print("|---|---:|---:|---:|---:|---:|---:|")
 for label, name in rows:
+    if os.path.exists(os.path.join(work, name + ".failed")):
+        print(f"| {label} | failed (see `{name}.log`) | | | | | |")
+        continue
     t = open(os.path.join(work, name + ".time")).read()
     q = json.load(open(os.path.join(work, name + ".quality.json")))
     s, mb = wall_seconds(t), peak_mb(t)

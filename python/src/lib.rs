@@ -880,13 +880,15 @@ impl Mesh {
     }
 
     /// Improve the mesh (edge and multi-face removal, edge contraction,
-    /// smoothing, boundary moves inside their patches and sliver-cap removal;
-    /// features detected at feature_angle as `--features auto` does) —
+    /// vertex insertion, smoothing, boundary moves inside their patches and
+    /// sliver-cap removal; features detected at feature_angle as `--features auto` does) —
     /// `tetrefine improve`. Returns a new Mesh whose `reports` hold one dict
     /// (passes, edges_removed, laplacian_moves, optimized_moves,
     /// surface_moves, line_moves, caps_removed, long_edges_split,
-    /// boundary_flips, edges_contracted, faces_removed; improve alone never
-    /// splits).
+    /// boundary_flips, edges_contracted, faces_removed, vertices_inserted;
+    /// improve alone never splits long edges, but it inserts a vertex where
+    /// a sliver needs one and contracts short edges, so the point count may
+    /// change).
     ///
     ///   opt_passes     Maximum passes of edge removal + smoothing
     ///                  [--opt-passes] (default 5).

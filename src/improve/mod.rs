@@ -7,6 +7,7 @@
 pub mod boundary_smooth;
 pub mod colour;
 pub mod effort;
+mod insertion;
 pub mod laplacian;
 mod long_edges;
 pub mod optimize;
@@ -80,6 +81,32 @@ impl BallPoints {
             self.pts.push(mesh.tet_points(t));
             self.at
                 .push(tv.iter().position(|&u| u == v).map_or(4, |i| i as u8));
+        }
+    }
+
+    /// Loads the ball a new vertex splitting the edge `(a, b)` would have:
+    /// both halves of each tet of the edge's `shell` (see
+    /// [`crate::ops::split_edge`]), the new vertex a placeholder id.
+    pub(crate) fn load_edge_split(&mut self, mesh: &TetMesh, a: u32, b: u32, shell: &[u32]) {
+        self.pts.clear();
+        self.at.clear();
+        self.ids.clear();
+        for &t in shell {
+            for half in crate::ops::split_halves(mesh.tet(t), a, b, u32::MAX) {
+                let at = half
+                    .iter()
+                    .position(|&u| u == u32::MAX)
+                    .expect("the new vertex");
+                self.ids.push(half);
+                self.pts.push(half.map(|u| {
+                    if u == u32::MAX {
+                        DVec3::ZERO
+                    } else {
+                        mesh.point(u)
+                    }
+                }));
+                self.at.push(at as u8);
+            }
         }
     }
 

@@ -33,6 +33,7 @@ pub use cap_removal::{is_cap_below, remove_boundary_cap, CapLimits};
 pub use edge_contraction::{contract_boundary_edge, contract_edge};
 pub use edge_removal::{remove_edge, EdgeRing};
 pub use edge_split::split_edge;
+pub(crate) use edge_split::split_halves;
 pub use face_removal::{remove_faces, FaceRemoval};
 pub use flip23::{flip23, flip23_tets, flip23_valid};
 pub use flip32::flip32;

@@ -59,7 +59,7 @@ pub fn run(a: Args) -> super::CliResult {
     );
     let after = MeshStats::compute(&mesh);
     crate::say!(
-        "min dihedral worst/avg: {:.2}° / {:.2}° -> {:.2}° / {:.2}°  ({} edges removed, {} Laplacian and {} optimized moves, {} boundary and {} feature-line moves, {} boundary caps removed, {} edges contracted, {} multi-face removals, in {} passes)",
+        "min dihedral worst/avg: {:.2}° / {:.2}° -> {:.2}° / {:.2}°  ({} edges removed, {} Laplacian and {} optimized moves, {} boundary and {} feature-line moves, {} boundary caps removed, {} edges contracted, {} multi-face removals, {} vertices inserted, in {} passes)",
         before.min_dihedral_deg.worst,
         before.min_dihedral_deg.avg,
         after.min_dihedral_deg.worst,
@@ -72,6 +72,7 @@ pub fn run(a: Args) -> super::CliResult {
         report.caps_removed,
         report.edges_contracted,
         report.faces_removed,
+        report.vertices_inserted,
         report.passes
     );
     super::write_mesh(&a.output, &mesh)
