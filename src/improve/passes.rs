@@ -223,6 +223,14 @@ impl Tracker {
         }
     }
 
+    /// The live tets that may change whose quality is below `bar`, in slot
+    /// order.
+    fn allowed_below(&self, mesh: &TetMesh, bar: f64) -> Vec<u32> {
+        (0..mesh.n_tet_slots() as u32)
+            .filter(|&t| mesh.is_alive(t) && self.tq[t as usize] < bar && self.is_allowed(t))
+            .collect()
+    }
+
     fn is_allowed(&self, t: u32) -> bool {
         self.allowed
             .as_ref()
@@ -460,9 +468,7 @@ fn contract_pass(
     opts: &ImproveOptions,
     report: &mut ImproveReport,
 ) -> usize {
-    let candidates: Vec<u32> = (0..mesh.n_tet_slots() as u32)
-        .filter(|&t| mesh.is_alive(t) && tr.tq[t as usize] < opts.threshold && tr.is_allowed(t))
-        .collect();
+    let candidates = tr.allowed_below(mesh, opts.threshold);
     let mut ball = Vec::new();
     let mut scratch = Vec::new();
     let mut contracted = 0;
@@ -544,9 +550,7 @@ fn insert_pass(
     opts: &ImproveOptions,
     report: &mut ImproveReport,
 ) -> usize {
-    let candidates: Vec<u32> = (0..mesh.n_tet_slots() as u32)
-        .filter(|&t| mesh.is_alive(t) && tr.tq[t as usize] < opts.threshold && tr.is_allowed(t))
-        .collect();
+    let candidates = tr.allowed_below(mesh, opts.threshold);
     let mut scratch = InsertionScratch::default();
     let mut shell = Vec::new();
     let mut inserted = 0;
