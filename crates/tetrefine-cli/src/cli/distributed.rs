@@ -85,13 +85,7 @@ pub fn run(a: Args) -> super::CliResult {
     if !pieces {
         tetrefine::io::Format::for_writing(&a.output).map_err(|e| e.to_string())?;
     }
-    super::outputs::refuse_shared_paths(&[
-        ("-o", Some(a.output.as_path())),
-        ("--stats", a.stats.as_deref()),
-        ("--histogram", a.histogram.as_deref()),
-        ("--features-out", a.features_out.as_deref()),
-        ("--parent-map", a.parent_map.as_deref()),
-    ])?;
+    super::outputs::refuse_shared_paths(&a.named_outputs())?;
     if let Some(f) = &a.features_out {
         tetrefine::PolylineFormat::of(f).map_err(|e| e.to_string())?;
     }

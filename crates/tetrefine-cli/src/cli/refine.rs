@@ -3,7 +3,7 @@
 
 use super::progress::BarProgress;
 use super::steps::StepStats;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 use tetrefine::io::read_indicator;
 use tetrefine::report::{step_row, step_table_header};
@@ -173,6 +173,20 @@ pub enum SmoothScope {
     All,
 }
 
+impl Args {
+    /// The output files the options name, each with its option (for
+    /// [`super::outputs::refuse_shared_paths`]).
+    pub fn named_outputs(&self) -> [(&'static str, Option<&Path>); 5] {
+        [
+            ("-o", Some(self.output.as_path())),
+            ("--stats", self.stats.as_deref()),
+            ("--histogram", self.histogram.as_deref()),
+            ("--features-out", self.features_out.as_deref()),
+            ("--parent-map", self.parent_map.as_deref()),
+        ]
+    }
+}
+
 /// The union of every selection option, or `None` for uniform refinement.
 pub fn mark_strategy(a: &Args) -> Result<Option<MarkStrategy>, String> {
     let mut specs: Vec<String> = a.marks.clone();
@@ -280,13 +294,7 @@ pub fn run(a: Args) -> super::CliResult {
         ));
     }
     tetrefine::io::Format::for_writing(&a.output).map_err(|e| e.to_string())?;
-    super::outputs::refuse_shared_paths(&[
-        ("-o", Some(a.output.as_path())),
-        ("--stats", a.stats.as_deref()),
-        ("--histogram", a.histogram.as_deref()),
-        ("--features-out", a.features_out.as_deref()),
-        ("--parent-map", a.parent_map.as_deref()),
-    ])?;
+    super::outputs::refuse_shared_paths(&a.named_outputs())?;
     let size_given =
         a.size.is_some() || a.size_array.is_some() || a.hsiz.is_some() || a.hmax.is_some();
     let n_steps = match (a.steps, size_given) {
@@ -503,12 +511,8 @@ pub(super) fn load_fields(
     let transfer = has_fields && !a.no_transfer;
     if transfer {
         let beside = tetrefine::io::fields_beside(&a.output);
-        super::outputs::refuse_shared_paths(&[
-            ("-o", Some(a.output.as_path())),
-            ("--stats", a.stats.as_deref()),
-            ("--histogram", a.histogram.as_deref()),
-            ("--features-out", a.features_out.as_deref()),
-            ("--parent-map", a.parent_map.as_deref()),
+        let mut outputs = a.named_outputs().to_vec();
+        outputs.extend([
             (
                 "the point fields beside -o",
                 beside.as_ref().map(|b| b.0.as_path()),
@@ -517,7 +521,8 @@ pub(super) fn load_fields(
                 "the cell fields beside -o",
                 beside.as_ref().map(|b| b.1.as_path()),
             ),
-        ])?;
+        ]);
+        super::outputs::refuse_shared_paths(&outputs)?;
         eprintln!(
             "transfer: {} point and {} cell fields of the input",
             meta.point_fields.len(),
