@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Side-by-side refinement benchmark on one input mesh:
 #
-#   tetrefine √3   one uniform √3 step       tetrefine refine IN -o OUT.vtu --steps 1
+#   tetrefine √3   STEPS uniform √3 steps    tetrefine refine IN -o OUT.vtu --steps STEPS
 #   TetGen         Debian's tetgen -r        -rqQa<vol>, <vol> set for a similar tet count
 #   MMG3D -optim   mmg3d_O3 (PyPI mmgpy)     quality optimization at the input's sizes
 #   MMG3D -hsiz    mmg3d_O3 (PyPI mmgpy)     uniform size <h>, set for a similar tet count, -hausd h/4
@@ -11,18 +11,25 @@
 # memory of the whole process, reading and writing included) and every output
 # is scored by `tetrefine quality --json`. Prints one Markdown table.
 #
-# Usage: benches/compare.sh IN [WORKDIR]
+# Usage: benches/compare.sh IN [WORKDIR [STEPS]]
 #   IN       any mesh tetrefine reads (.mesh, .msh, .vtu, .node)
 #   WORKDIR  where inputs/outputs/logs go (default: a new temporary directory)
+#   STEPS    √3 steps (default 1): the others are set for the count STEPS
+#            steps give; the 1:8 bisection runs min(STEPS, 2) steps
 #
 # Runs on a fresh machine as root: installs `time` and `tetgen` with apt-get
 # and `mmgpy` with pip when they are missing, and builds tetrefine in release.
 set -euo pipefail
 
-if [ $# -lt 1 ] || [ $# -gt 2 ]; then
-    echo "usage: $0 IN [WORKDIR]" >&2
+if [ $# -lt 1 ] || [ $# -gt 3 ]; then
+    echo "usage: $0 IN [WORKDIR [STEPS]]" >&2
     exit 2
 fi
+STEPS=${3:-1}
+case "$STEPS" in
+    [1-9]) ;;
+    *) echo "error: STEPS must be 1 to 9, not '$STEPS'" >&2; exit 2 ;;
+esac
 IN=$(realpath "$1")
 [ -f "$IN" ] || { echo "error: $1: no such file" >&2; exit 1; }
 ROOT=$(cd "$(dirname "$0")/.." && pwd)
@@ -122,7 +129,7 @@ VOL=$(json "$WORK/input.quality.json" "d['volume']")
 say "input: $N_IN tets, volume $VOL"
 
 # ---- tetrefine √3 (sets the target count for the others) ---------------------
-run sqrt3 "$T" refine "$IN" -o "$WORK/sqrt3.vtu" --steps 1 --stats "$WORK/sqrt3.stats.json"
+run sqrt3 "$T" refine "$IN" -o "$WORK/sqrt3.vtu" --steps "$STEPS" --stats "$WORK/sqrt3.stats.json"
 score sqrt3 "$WORK/sqrt3.vtu"
 TARGET=$(json "$WORK/sqrt3.quality.json" "d['tets']")
 say "target tet count: $TARGET"
@@ -146,8 +153,11 @@ for attempt in 1 2 3; do
 done
 
 # ---- MMG3D -optim (quality optimization at the input's own sizes) -----------
-other mmg_optim "$MMG" -v 0 -optim "$WORK/in.mesh" -out "$WORK/mmg_optim.mesh" &&
-    score mmg_optim "$WORK/mmg_optim.mesh"
+# (at the input's sizes, so the same for any STEPS: run with STEPS = 1 only)
+if [ "$STEPS" = 1 ]; then
+    other mmg_optim "$MMG" -v 0 -optim "$WORK/in.mesh" -out "$WORK/mmg_optim.mesh" &&
+        score mmg_optim "$WORK/mmg_optim.mesh"
+fi
 
 # ---- MMG3D -hsiz (uniform size for a similar count) --------------------------
 # MMG's tets at size h average about 0.094 h³ (measured on mmg_tinyBoxt).
@@ -167,17 +177,17 @@ for attempt in 1 2 3; do
 done
 
 # ---- tetrefine 1:8 bisection --------------------------------------------------
-run bisect "$T" bisect "$IN" -o "$WORK/bisect.vtu"
+run bisect "$T" bisect "$IN" -o "$WORK/bisect.vtu" --steps "$(( STEPS < 2 ? STEPS : 2 ))"
 score bisect "$WORK/bisect.vtu"
 
 # ---- table --------------------------------------------------------------------
-"$PY" - "$WORK" "$IN" "$N_IN" "$T" "$MMG" <<'EOF'
+"$PY" - "$WORK" "$IN" "$N_IN" "$T" "$MMG" "$STEPS" <<'EOF'
 import json, os, re, sys
 
-work, path, n_in, tetrefine, mmg = sys.argv[1:6]
-n_in = int(n_in)
+work, path, n_in, tetrefine, mmg, steps = sys.argv[1:7]
+n_in, steps = int(n_in), int(steps)
 rows = [
-    ("tetrefine √3 (1 step)", "sqrt3"),
+    (f"tetrefine √3 ({steps} step{'s' if steps > 1 else ''})", "sqrt3"),
     ("TetGen 1.5 `-rq -a`", "tetgen"),
     ("MMG3D 5.8 `-optim`", "mmg_optim"),
     ("MMG3D 5.8 `-hsiz`", "mmg_hsiz"),
@@ -200,6 +210,9 @@ print(f"Input: `{os.path.basename(path)}`, {n_in:,} tets.\n")
 print("| tool | seconds | output tets | output tets/s | min dihedral worst / avg (°) | max dihedral worst (°) | peak memory (MB) |")
 print("|---|---:|---:|---:|---:|---:|---:|")
 for label, name in rows:
+    if not os.path.exists(os.path.join(work, name + ".cmd")):
+        print(f"| {label} | not run (STEPS > 1) | | | | | |")
+        continue
     if os.path.exists(os.path.join(work, name + ".failed")):
         print(f"| {label} | failed (see `{name}.log`) | | | | | |")
         continue
@@ -214,6 +227,8 @@ print()
 print("Commands (as run):")
 print()
 for label, name in rows:
+    if not os.path.exists(os.path.join(work, name + ".cmd")):
+        continue
     cmd = open(os.path.join(work, name + ".cmd")).read().strip()
     cmd = cmd.replace(work + "/", "").replace(tetrefine, "tetrefine").replace(mmg, "mmg3d_O3")
     cmd = cmd.replace(path, os.path.basename(path))
@@ -222,10 +237,11 @@ for label, name in rows:
 # tetrefine's own timing of the refinement alone (the table's seconds are
 # whole processes: reading, refining, writing).
 sqrt3 = json.load(open(os.path.join(work, "sqrt3.stats.json")))
-step = sqrt3["steps"][-1] if isinstance(sqrt3, dict) and "steps" in sqrt3 else None
+done = sqrt3["steps"][1:] if isinstance(sqrt3, dict) and "steps" in sqrt3 else []
 inner = []
-if step and "seconds" in step:
-    inner.append(f"√3 step {step['seconds']:.2f} s")
+if done and all("seconds" in x for x in done):
+    inner.append("√3 step" + ("s " if len(done) > 1 else " ")
+                 + " + ".join(f"{x['seconds']:.2f}" for x in done) + " s")
 m = re.search(r"step 1: .* ([0-9.]+) s \(", open(os.path.join(work, "bisect.log")).read())
 if m:
     inner.append(f"bisection step {float(m.group(1)):.2f} s")
