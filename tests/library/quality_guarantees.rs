@@ -21,8 +21,8 @@ use std::collections::HashSet;
 use std::path::Path;
 use tetrefine::geom::tet_volume;
 use tetrefine::{
-    detect_features, improve, load_mesh, refine_step, ImproveOptions, MeshStats, RefineOptions,
-    Sqrt3Rule, TetMesh,
+    detect_features, improve, load_mesh, refine_step, ImproveOptions, ImproveReport, MeshStats,
+    RefineOptions, Sqrt3Rule, TetMesh,
 };
 
 const SMALL: [&str; 4] = ["mmg_cube", "getfem_holed_bar", "getfem_ladder", "tripod"];
@@ -395,11 +395,6 @@ fn linear_boundary_moves_keep_region_volumes_of_boxes() {
     }
 }
 
-/// Boundary 2-2 flips in `improve` (`BoundarySmoothOptions::flip_edges`,
-/// off by default: measured below): on every small mesh after one fast
-/// step (the raw √3 step), with only exactly coplanar faces allowed (crease angle 0), flips
-/// happen, never lower the worst angle, and keep the domain exactly: its
-/// volume, and the count of boundary faces (a flip trades two for two).
 /// One √3 step of `name` (features at 45°) with no optimize phase, so
 /// that what an operation under test finds to do does not depend on the
 /// passes.
@@ -418,12 +413,40 @@ fn raw_step(name: &str, rule: Sqrt3Rule) -> TetMesh {
     m
 }
 
+/// Runs `improve` with `opts` on `m` (a step of `name`) and checks what
+/// every operation under test keeps: no tet inverted and `check()` passing
+/// (`checked_worst`), the worst angle not lower, every region's volume (to
+/// rounding). Returns the statistics before and after, and the report.
+fn improve_checked(
+    name: &str,
+    m: &mut TetMesh,
+    opts: &ImproveOptions,
+) -> (MeshStats, MeshStats, ImproveReport) {
+    let before = MeshStats::compute(m);
+    let volumes = region_volumes(m);
+    let worst = checked_worst(m, name);
+    let r = improve(m, opts);
+    assert!(checked_worst(m, name) >= worst, "{name}: worst fell");
+    let after = MeshStats::compute(m);
+    for ((ra, va), (rb, vb)) in volumes.iter().zip(region_volumes(m)) {
+        assert_eq!(*ra, rb);
+        assert!(
+            (va - vb).abs() <= 1e-12 * va,
+            "{name} region {ra}: {va} -> {vb}"
+        );
+    }
+    (before, after, r)
+}
+
+/// Boundary 2-2 flips in `improve` (`BoundarySmoothOptions::flip_edges`,
+/// off by default: measured below): on every small mesh after one fast
+/// step (the raw √3 step), with only exactly coplanar faces allowed (crease angle 0), flips
+/// happen, never lower the worst angle, and keep the domain exactly: its
+/// volume, and the count of boundary faces (a flip trades two for two).
 #[test]
 fn boundary_flips_keep_the_domain_and_the_worst() {
     for name in SMALL {
         let mut m = raw_step(name, Sqrt3Rule::Interpolating);
-        let before = MeshStats::compute(&m);
-        let worst = checked_worst(&m, name);
         // One pass with the passes' own bars at (about) zero: only the
         // flip sweep after it works (the boundary smoother's bar, 0.4, picks
         // its candidates).
@@ -439,16 +462,8 @@ fn boundary_flips_keep_the_domain_and_the_worst() {
             }),
             ..Default::default()
         };
-        let r = improve(&mut m, &opts);
-        let after = MeshStats::compute(&m);
+        let (before, after, r) = improve_checked(name, &mut m, &opts);
         assert!(r.boundary_flips > 0, "{name}: no flip");
-        assert!(checked_worst(&m, name) >= worst, "{name}: worst fell");
-        assert!(
-            (after.volume - before.volume).abs() <= 1e-12 * before.volume,
-            "{name}: volume {} -> {}",
-            before.volume,
-            after.volume
-        );
         assert_eq!(after.boundary_faces, before.boundary_faces, "{name}");
     }
 }
@@ -458,8 +473,6 @@ fn boundary_contractions_keep_the_domain_and_the_worst() {
     let mut fewer_faces = 0;
     for name in SMALL {
         let mut m = raw_step(name, Sqrt3Rule::Linear);
-        let before = MeshStats::compute(&m);
-        let worst = checked_worst(&m, name);
         // One pass (no interior contraction: that waits for a second) with
         // flat stars only, then the boundary contractions after it.
         let opts = ImproveOptions {
@@ -474,15 +487,7 @@ fn boundary_contractions_keep_the_domain_and_the_worst() {
             }),
             ..Default::default()
         };
-        improve(&mut m, &opts);
-        let after = MeshStats::compute(&m);
-        assert!(checked_worst(&m, name) >= worst, "{name}: worst fell");
-        assert!(
-            (after.volume - before.volume).abs() <= 1e-12 * before.volume,
-            "{name}: volume {} -> {}",
-            before.volume,
-            after.volume
-        );
+        let (before, after, _) = improve_checked(name, &mut m, &opts);
         // A boundary contraction replaces a vertex's k faces by k - 2.
         assert!(after.boundary_faces <= before.boundary_faces, "{name}");
         assert_eq!(after.boundary_faces % 2, before.boundary_faces % 2);
@@ -508,9 +513,6 @@ fn face_removals_keep_the_regions_and_the_worst() {
                 ..Default::default()
             },
         );
-        let before = MeshStats::compute(&m);
-        let volumes = region_volumes(&m);
-        let worst = checked_worst(&m, name);
         let opts = ImproveOptions {
             passes: 1,
             threshold: 1e-9,
@@ -518,19 +520,38 @@ fn face_removals_keep_the_regions_and_the_worst() {
             boundary: None,
             ..Default::default()
         };
-        let r = improve(&mut m, &opts);
+        let (before, after, r) = improve_checked(name, &mut m, &opts);
         assert!(r.faces_removed > 0, "{name}: no face removed");
         assert_eq!((r.laplacian_moves, r.optimized_moves), (0, 0));
-        assert!(checked_worst(&m, name) >= worst, "{name}: worst fell");
-        let after = MeshStats::compute(&m);
         assert_eq!(after.boundary_faces, before.boundary_faces, "{name}");
         assert_eq!(after.nodes, before.nodes, "{name}: points come or go");
-        for ((ra, va), (rb, vb)) in volumes.iter().zip(region_volumes(&m)) {
-            assert_eq!(*ra, rb);
-            assert!(
-                (va - vb).abs() <= 1e-12 * va,
-                "{name} region {ra}: {va} -> {vb}"
-            );
-        }
     }
+}
+
+/// Vertex insertion (issue 14, Deliver 3): on every small mesh after the
+/// raw √3 step, three passes with the boundary fixed insert vertices on
+/// some mesh, never lower the worst angle, keep every region's volume and
+/// the boundary's faces (an insertion splits an interior edge inside one
+/// region), and each inserted point is one more point than the passes'
+/// contractions leave: points = before + insertions − contractions.
+#[test]
+fn vertex_insertions_keep_the_regions_and_the_worst() {
+    let mut inserted = 0;
+    for name in SMALL {
+        let mut m = raw_step(name, Sqrt3Rule::Interpolating);
+        let opts = ImproveOptions {
+            passes: 3,
+            boundary: None,
+            ..Default::default()
+        };
+        let (before, after, r) = improve_checked(name, &mut m, &opts);
+        assert_eq!(after.boundary_faces, before.boundary_faces, "{name}");
+        assert_eq!(
+            after.nodes,
+            before.nodes + r.vertices_inserted - r.edges_contracted,
+            "{name}"
+        );
+        inserted += r.vertices_inserted;
+    }
+    assert!(inserted > 0, "no vertex inserted on any mesh");
 }
