@@ -241,7 +241,8 @@ pub struct SizeOptions {
     /// below, measured in the metric for an anisotropic map (`None`: the
     /// worst tet of the mesh when the pass begins, measured in the metric).
     pub quality_floor: Option<f64>,
-    /// The optimize phase after the splits (`passes: 0` skips it).
+    /// The optimize phase after the splits (`passes: 0` skips it; vertex
+    /// insertion is off there whatever this says, see [`size_pass`]).
     pub improve: ImproveOptions,
 }
 
@@ -345,7 +346,14 @@ pub fn size_pass(mesh: &mut TetMesh, size: &mut SizeMap, opts: &SizeOptions) -> 
         }
     }
     if opts.improve.passes > 0 {
-        improve(mesh, &opts.improve);
+        // No vertex insertion: an inserted point would need a metric, and
+        // the map only knows how to give one to the midpoint of a split
+        // it made (`push_mean`).
+        let io = ImproveOptions {
+            insert_vertices: false,
+            ..opts.improve.clone()
+        };
+        improve(mesh, &io);
     }
     debug_assert_eq!(size.len(), mesh.n_points());
     report.long_after = long_edges(mesh, size).len();
