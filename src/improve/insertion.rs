@@ -30,12 +30,14 @@ const PARAMS: OptimizeParams = OptimizeParams {
 };
 
 /// A split that raises the worst tet of an edge's shell.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub(crate) struct InsertionPlan {
     /// First end of the edge.
     pub a: u32,
     /// Second end of the edge.
     pub b: u32,
+    /// The tets around the edge, which the split replaces.
+    pub shell: Vec<u32>,
     /// Where the new vertex goes.
     pub x: DVec3,
     /// The worst min-sine of the new tets there.
@@ -52,15 +54,15 @@ pub(crate) struct InsertionScratch {
 }
 
 /// The best split of an edge of tet `t` whose new vertex raises the worst
-/// tet of the edge's shell (qualities in `tq`, by slot) above `beat` and
-/// above the shell's worst. Only edges inside one region are tried: a closed
+/// of the new tets above `beat`. Callers pass `t`'s own quality: every
+/// shell holds `t`, so its worst is at most that and the split raises it.
+/// Only edges inside one region are tried: a closed
 /// shell, no marked face holding the edge, no feature tag, every shell tet
 /// allowed by `allowed` — so the new vertex is an interior vertex and the
 /// domain, interfaces and tags stay as they are.
 pub(crate) fn plan_insertion(
     mesh: &TetMesh,
     t: u32,
-    tq: &[f64],
     beat: f64,
     allowed: impl Fn(u32) -> bool,
     s: &mut InsertionScratch,
@@ -83,14 +85,7 @@ pub(crate) fn plan_insertion(
         {
             continue;
         }
-        let shell_worst = ring
-            .tets
-            .iter()
-            .map(|&x| tq[x as usize])
-            .fold(f64::INFINITY, f64::min);
-        let bar = beat
-            .max(shell_worst)
-            .max(best.map_or(f64::NEG_INFINITY, |b| b.quality));
+        let bar = beat.max(best.as_ref().map_or(f64::NEG_INFINITY, |b| b.quality));
         s.ball.load_edge_split(mesh, ring.a, ring.b, &ring.tets);
         // Two starts: the edge's midpoint, and the centroid of the shell's
         // vertices (the Laplacian position, which for a sliver's diagonal
@@ -114,6 +109,7 @@ pub(crate) fn plan_insertion(
             best = Some(InsertionPlan {
                 a: ring.a,
                 b: ring.b,
+                shell: ring.tets.clone(),
                 x,
                 quality: q,
             });
@@ -168,12 +164,16 @@ mod tests {
         let tq = qualities(&m);
         assert!(tq[t as usize] < 0.1, "a sliver: {}", tq[t as usize]);
         let mut s = InsertionScratch::default();
-        let plan =
-            plan_insertion(&m, t, &tq, tq[t as usize], |_| true, &mut s).expect("an insertion");
+        let plan = plan_insertion(&m, t, tq[t as usize], |_| true, &mut s).expect("an insertion");
         assert!(m.tet(t).contains(&plan.a) && m.tet(t).contains(&plan.b));
         let mut shell = Vec::new();
         m.ball(plan.a, &mut shell);
         shell.retain(|&x| m.tet(x).contains(&plan.b));
+        // The plan's shell is the edge's, found through the ball of `a`.
+        let mut planned = plan.shell.clone();
+        planned.sort_unstable();
+        shell.sort_unstable();
+        assert_eq!(planned, shell);
         let shell_worst = shell
             .iter()
             .map(|&x| tq[x as usize])
@@ -204,27 +204,27 @@ mod tests {
         let tq = qualities(&m);
         let mut s = InsertionScratch::default();
         let q = tq[t as usize];
-        assert!(plan_insertion(&m, t, &tq, q, |_| true, &mut s).is_some());
+        assert!(plan_insertion(&m, t, q, |_| true, &mut s).is_some());
         let tv = m.tet(t);
         // A shell holding a tet the caller refuses.
-        assert_eq!(plan_insertion(&m, t, &tq, q, |x| x != t, &mut s), None);
+        assert_eq!(plan_insertion(&m, t, q, |x| x != t, &mut s), None);
         // Feature edges.
         let mut f = m.clone();
         for [i, j] in TET_EDGES {
             f.set_feature_edge(tv[i], tv[j], Some(1));
         }
-        assert_eq!(plan_insertion(&f, t, &tq, q, |_| true, &mut s), None);
+        assert_eq!(plan_insertion(&f, t, q, |_| true, &mut s), None);
         // A marked face on each edge (an embedded surface).
         let mut f = m.clone();
         for face in TET_FACES {
             f.set_face_marker(face.map(|k| tv[k]), Some(3));
         }
-        assert_eq!(plan_insertion(&f, t, &tq, q, |_| true, &mut s), None);
+        assert_eq!(plan_insertion(&f, t, q, |_| true, &mut s), None);
         // Another region around the sliver: every shell crosses an interface.
         let mut f = m.clone();
         for x in m.tet_ids().filter(|&x| x != t) {
             f.set_region(x, 7);
         }
-        assert_eq!(plan_insertion(&f, t, &tq, q, |_| true, &mut s), None);
+        assert_eq!(plan_insertion(&f, t, q, |_| true, &mut s), None);
     }
 }

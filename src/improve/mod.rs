@@ -86,7 +86,9 @@ impl BallPoints {
 
     /// Loads the ball a new vertex splitting the edge `(a, b)` would have:
     /// both halves of each tet of the edge's `shell` (see
-    /// [`crate::ops::split_edge`]), the new vertex a placeholder id.
+    /// [`crate::ops::split_edge`]), the new vertex a placeholder id
+    /// (`u32::MAX`: [`BallPoints::neighbour_centroid`], which indexes by
+    /// id, does not apply to such a ball).
     pub(crate) fn load_edge_split(&mut self, mesh: &TetMesh, a: u32, b: u32, shell: &[u32]) {
         self.pts.clear();
         self.at.clear();

@@ -289,9 +289,9 @@ pub fn improve(mesh: &mut TetMesh, opts: &ImproveOptions) -> ImproveReport {
         changed += face_pass(mesh, &mut tr, &edges.examined, &movable, opts, &mut report);
         if pass >= CONTRACT_FROM_PASS {
             changed += contract_pass(mesh, &mut tr, &mut movable, None, opts, &mut report);
-            if opts.insert_vertices && pass >= INSERT_FROM_PASS {
-                changed += insert_pass(mesh, &mut tr, &mut movable, &mut zone, opts, &mut report);
-            }
+        }
+        if opts.insert_vertices && pass >= INSERT_FROM_PASS {
+            changed += insert_pass(mesh, &mut tr, &mut movable, &mut zone, opts, &mut report);
         }
         changed += smooth_pass(mesh, &mut tr, &movable, opts, &mut report);
         if let Some(s) = &surface {
@@ -552,24 +552,20 @@ fn insert_pass(
 ) -> usize {
     let candidates = tr.allowed_below(mesh, opts.threshold);
     let mut scratch = InsertionScratch::default();
-    let mut shell = Vec::new();
     let mut inserted = 0;
     for t in candidates {
         let q = tr.tq[t as usize];
         if !mesh.is_alive(t) || q >= opts.threshold {
             continue;
         }
-        let Some(plan) = plan_insertion(mesh, t, &tr.tq, q, |x| tr.is_allowed(x), &mut scratch)
-        else {
+        let Some(plan) = plan_insertion(mesh, t, q, |x| tr.is_allowed(x), &mut scratch) else {
             continue;
         };
-        mesh.ball(plan.a, &mut shell);
-        shell.retain(|&x| mesh.tet(x).contains(&plan.b));
         if let Ok((m, new)) = split_edge(mesh, plan.a, plan.b, plan.x) {
             debug_assert_eq!(m as usize, movable.len());
             movable.push(true);
             zone.push(true);
-            tr.replaced(mesh, &shell, &new);
+            tr.replaced(mesh, &plan.shell, &new);
             inserted += 1;
         }
     }
