@@ -25,7 +25,7 @@ use crate::mesh::fasthash::{FastHashMap, FastHashSet};
 use crate::mesh::{edge_key, EdgeKey, TetMesh};
 use crate::ops::edge_removal::{apply_ring_triangulation, RingTriangulation};
 use crate::ops::edge_removal::{best_ring_triangulation_above, RingScratch};
-use crate::ops::face_removal::{apply_face_removal, plan_face_removal, FacePlan};
+use crate::ops::face_removal::{apply_face_removal, plan_face_removal, FacePlan, FaceScratch};
 use crate::ops::{boundary_flip_ring, flip_boundary_edge, BoundaryFlipLimits, TetsAtVertex};
 use crate::ops::{is_cap_below, remove_boundary_cap, CapLimits};
 use crate::ops::{split_edge, EdgeRing};
@@ -359,11 +359,14 @@ fn face_pass(
         candidates
             .par_iter()
             .with_min_len(256)
-            .map(|&t| first_face_plan(mesh, tr, t, 0, movable, opts))
+            .map_init(FaceScratch::default, |s, &t| {
+                first_face_plan(mesh, tr, t, 0, movable, opts, s)
+            })
             .collect()
     };
     let mut touched = vec![false; mesh.n_points()];
     let mut removed = 0;
+    let mut scratch = FaceScratch::default();
     for (&t, plan) in candidates.iter().zip(found) {
         if !mesh.is_alive(t) || tr.tq[t as usize] >= opts.edge_threshold {
             continue;
@@ -375,7 +378,7 @@ fn face_pass(
                     && touched[mesh.tet(h >> 2)[(h & 3) as usize] as usize])
         });
         let mut plan = if stale {
-            first_face_plan(mesh, tr, t, 0, movable, opts)
+            first_face_plan(mesh, tr, t, 0, movable, opts, &mut scratch)
         } else {
             plan
         };
@@ -393,12 +396,12 @@ fn face_pass(
                     // The sweep goes on at the next face of slot `t`, which
                     // the removal may have re-used for one of its new tets.
                     plan = if mesh.is_alive(t) && tr.tq[t as usize] < opts.edge_threshold {
-                        first_face_plan(mesh, tr, t, f + 1, movable, opts)
+                        first_face_plan(mesh, tr, t, f + 1, movable, opts, &mut scratch)
                     } else {
                         None
                     };
                 }
-                Err(_) => plan = first_face_plan(mesh, tr, t, f + 1, movable, opts),
+                Err(_) => plan = first_face_plan(mesh, tr, t, f + 1, movable, opts, &mut scratch),
             }
         }
     }
@@ -415,6 +418,7 @@ fn first_face_plan(
     from: usize,
     movable: &[bool],
     opts: &ImproveOptions,
+    scratch: &mut FaceScratch,
 ) -> Option<(usize, FacePlan)> {
     // A candidate the edge pass removed (its slot free) or lifted.
     if !mesh.is_alive(t) || tr.tq[t as usize] >= opts.edge_threshold {
@@ -432,7 +436,7 @@ fn first_face_plan(
         {
             return None;
         }
-        plan_face_removal(mesh, t, f, beat, opts.max_ring, &allowed)
+        plan_face_removal(mesh, t, f, beat, opts.max_ring, &allowed, scratch)
             .ok()
             .map(|p| (f, p))
     })

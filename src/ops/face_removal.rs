@@ -92,7 +92,15 @@ pub fn remove_faces(
     max_faces: usize,
     allowed: &dyn Fn(u32) -> bool,
 ) -> Result<FaceRemoval, OpError> {
-    let plan = plan_face_removal(mesh, t, f, beat, max_faces, allowed)?;
+    let plan = plan_face_removal(
+        mesh,
+        t,
+        f,
+        beat,
+        max_faces,
+        allowed,
+        &mut FaceScratch::default(),
+    )?;
     apply_face_removal(mesh, &plan)
 }
 
@@ -130,6 +138,7 @@ pub(crate) fn plan_face_removal(
     beat: f64,
     max_faces: usize,
     allowed: &dyn Fn(u32) -> bool,
+    scratch: &mut FaceScratch,
 ) -> Result<FacePlan, OpError> {
     let h = mesh.adj(t)[f];
     if h == NO_ADJ {
@@ -146,23 +155,62 @@ pub(crate) fn plan_face_removal(
     }
     let u = tv[f];
     let w = mesh.tet(tw)[(h & 3) as usize];
-    let nodes = grow(mesh, u, w, t, tw, face, max_faces.max(1), allowed);
+    let FaceScratch {
+        nodes,
+        seen,
+        value,
+        go_on,
+    } = scratch;
+    grow(
+        mesh,
+        u,
+        w,
+        t,
+        tw,
+        face,
+        max_faces.max(1),
+        allowed,
+        nodes,
+        seen,
+    );
     let (pu, pw) = (mesh.point(u), mesh.point(w));
-    // Quality of the new tet of side k of a node, or −∞ if it does not
-    // beat the bar (the exact predicate only runs on tets that do).
+    // Quality of the new tet of side k of a node, or DEAD if it does not
+    // beat the bar. The float orientation goes first: an inverted or flat
+    // tet is dead without its normals (a tet the float sign calls flat but
+    // the exact predicate positive would be refused too: refusing is
+    // safe). The exact predicate only runs on tets that beat the bar.
     let side_q = |n: &Node, k: usize| -> f64 {
         let (a, b) = (n.face[k], n.face[(k + 1) % 3]);
         let p = [pu, mesh.point(a), mesh.point(b), pw];
+        if (p[1] - p[0]).dot((p[2] - p[0]).cross(p[3] - p[0])) <= 0.0 {
+            return DEAD;
+        }
         let q = tet_min_sine(&p);
         if q.is_nan() || q <= beat || !is_positive(&p) {
-            f64::NEG_INFINITY
+            DEAD
         } else {
             q
         }
     };
-    // Children come after their parent in `nodes`: values bottom-up.
-    let mut value = vec![f64::INFINITY; nodes.len()];
-    let mut go_on = vec![[false; 3]; nodes.len()];
+    // A side of the root with no face behind it can only stop there: if
+    // that tet is dead, so is every subtree (most tries end here).
+    let root = &nodes[0];
+    let mut root_stop = [f64::NAN; 3];
+    for (k, stop) in root_stop.iter_mut().enumerate() {
+        if root.child[k] == NONE {
+            *stop = side_q(root, k);
+            if *stop == DEAD {
+                return Err(refusal(beat));
+            }
+        }
+    }
+    // Children come after their parent in `nodes`: values bottom-up. A
+    // value at or below the bar is DEAD, so a node with one dead side is
+    // dead whatever its other sides give, and they are not evaluated.
+    value.clear();
+    value.resize(nodes.len(), f64::INFINITY);
+    go_on.clear();
+    go_on.resize(nodes.len(), [false; 3]);
     for i in (0..nodes.len()).rev() {
         let n = &nodes[i];
         let mut v = f64::INFINITY;
@@ -170,25 +218,26 @@ pub(crate) fn plan_face_removal(
             if k == n.up {
                 continue;
             }
-            let stop = side_q(n, k);
+            let stop = if i == 0 && !root_stop[k].is_nan() {
+                root_stop[k]
+            } else {
+                side_q(n, k)
+            };
             let deeper = if n.child[k] == NONE {
-                f64::NEG_INFINITY
+                DEAD
             } else {
                 value[n.child[k] as usize]
             };
             go_on[i][k] = deeper > stop;
             v = v.min(stop.max(deeper));
+            if v == DEAD {
+                break;
+            }
         }
         value[i] = v;
     }
-    if value[0] <= beat || value[0] == f64::NEG_INFINITY {
-        // Below a finite bar, an invalid subtree and one that does not beat
-        // it look the same (the exact predicate was skipped).
-        return Err(if beat == f64::NEG_INFINITY {
-            OpError::WouldInvert
-        } else {
-            OpError::NoImprovement
-        });
+    if value[0] <= beat || value[0] == DEAD {
+        return Err(refusal(beat));
     }
     let mut old = Vec::new();
     let mut new = Vec::new();
@@ -210,6 +259,34 @@ pub(crate) fn plan_face_removal(
     }
     debug_assert_eq!(new.len(), old.len() / 2 + 2);
     Ok(FacePlan { u, w, old, new })
+}
+
+/// The value of a side or subtree whose worst new tet does not beat the
+/// bar, or is not positive.
+const DEAD: f64 = f64::NEG_INFINITY;
+
+/// Why no subtree was found: below a finite bar, an invalid subtree and
+/// one that does not beat it look the same (the exact predicate was
+/// skipped).
+fn refusal(beat: f64) -> OpError {
+    if beat == f64::NEG_INFINITY {
+        OpError::WouldInvert
+    } else {
+        OpError::NoImprovement
+    }
+}
+
+/// Reusable buffers of [`plan_face_removal`] (one per thread of a sweep).
+#[derive(Default)]
+pub(crate) struct FaceScratch {
+    /// The growth tree.
+    nodes: Vec<Node>,
+    /// Its faces' keys.
+    seen: Vec<FaceKey>,
+    /// Per node: the worst new tet of its best subtree, or [`DEAD`].
+    value: Vec<f64>,
+    /// Per node and side: the best subtree goes on into the child.
+    go_on: Vec<[bool; 3]>,
 }
 
 /// Applies a plan whose cavity is current ([`FacePlan::is_current`]):
@@ -235,7 +312,8 @@ pub(crate) fn apply_face_removal(
 }
 
 /// The tree of faces sandwiched between `u` and `w`, breadth first from
-/// `face` (tets `tu`, `tw`), at most `max` of them.
+/// `face` (tets `tu`, `tw`), at most `max` of them, into `nodes` (`seen`
+/// holds their keys).
 #[allow(clippy::too_many_arguments)]
 fn grow(
     mesh: &TetMesh,
@@ -246,15 +324,19 @@ fn grow(
     face: [u32; 3],
     max: usize,
     allowed: &dyn Fn(u32) -> bool,
-) -> Vec<Node> {
-    let mut nodes = vec![Node {
+    nodes: &mut Vec<Node>,
+    seen: &mut Vec<FaceKey>,
+) {
+    nodes.clear();
+    nodes.push(Node {
         face,
         tu,
         tw,
         up: usize::MAX,
         child: [NONE; 3],
-    }];
-    let mut seen: Vec<FaceKey> = vec![face_key(face)];
+    });
+    seen.clear();
+    seen.push(face_key(face));
     let mut i = 0;
     while i < nodes.len() {
         let n = nodes[i];
@@ -279,7 +361,6 @@ fn grow(
         }
         i += 1;
     }
-    nodes
 }
 
 /// The sandwiched face across side `(a, b)` of the face `(a, b, c)` with
@@ -414,6 +495,53 @@ mod tests {
     /// Hexagon area 3√3/2; bipyramid volume area · 2h / 3.
     fn hexagon_bipyramid_volume(h: f64) -> f64 {
         1.5 * 3f64.sqrt() * 2.0 * h / 3.0
+    }
+
+    /// One scratch reused over every face of a jittered grid plans what a
+    /// fresh scratch plans: no state of one try leaks into the next (a
+    /// stale node, value or flag would change a plan or a refusal).
+    #[test]
+    fn a_reused_scratch_plans_as_a_fresh_one() {
+        let mut data = crate::mesh::generate::cube_grid(4);
+        let mut rng = crate::rng::SplitMix64(7);
+        for p in &mut data.points {
+            if p.iter().all(|&c| c > 0.0 && c < 1.0) {
+                for c in p.iter_mut() {
+                    *c += 0.08 * (rng.next_f64() - 0.5);
+                }
+            }
+        }
+        let (mesh, _) = TetMesh::from_data(&data).expect("valid grid");
+        let summary = |r: Result<FacePlan, OpError>| match r {
+            Ok(p) => Ok((p.u, p.w, p.old, p.new)),
+            Err(e) => Err(format!("{e:?}")),
+        };
+        let mut shared = FaceScratch::default();
+        let (mut plans, mut refusals) = (0, 0);
+        for t in mesh.tet_ids() {
+            let beat = tet_min_sine(&mesh.tet_points(t));
+            for f in 0..4 {
+                let a = plan_face_removal(&mesh, t, f, beat, 10, &|_| true, &mut shared);
+                let b = plan_face_removal(
+                    &mesh,
+                    t,
+                    f,
+                    beat,
+                    10,
+                    &|_| true,
+                    &mut FaceScratch::default(),
+                );
+                let (a, b) = (summary(a), summary(b));
+                if a.is_ok() {
+                    plans += 1;
+                } else {
+                    refusals += 1;
+                }
+                assert_eq!(a, b, "tet {t} face {f}");
+            }
+        }
+        // The fixture must exercise both outcomes.
+        assert!(plans > 0 && refusals > 0, "{plans} plans, {refusals} refusals");
     }
 
     #[test]
