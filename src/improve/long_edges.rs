@@ -40,6 +40,11 @@ fn neighbours(mesh: &TetMesh, v: u32, ball: &mut Vec<u32>, out: &mut Vec<u32>) {
     out.dedup();
 }
 
+/// A block of consecutive vertices: per vertex its mean edge length and the
+/// end (exclusive) of its run in the third list, the neighbours of higher
+/// id with the edge's length.
+type NeighbourBlock = (Vec<f64>, Vec<u32>, Vec<(u32, f64)>);
+
 /// The tets holding edge `(a, b)`, from the ball of `a`.
 fn shell(mesh: &TetMesh, a: u32, b: u32, out: &mut Vec<u32>) {
     mesh.ball(a, out);
@@ -100,40 +105,59 @@ pub(crate) fn split_long_edges(
     }
     let n = mesh.n_points() as u32;
     let fixed = mesh.fixed_vertices();
-    let mean_len: Vec<f64> = {
+    // One ball walk per vertex: its mean edge length, and its neighbours of
+    // higher id with the edge's length (each edge once, at its lower end),
+    // by blocks of vertices so that the lists stay in a few flat arrays.
+    const BLOCK: u32 = 1024;
+    let blocks: Vec<NeighbourBlock> = {
         let mesh = &*mesh;
-        (0..n)
+        (0..n.div_ceil(BLOCK))
             .into_par_iter()
-            .with_min_len(1024)
             .map_init(
                 || (Vec::new(), Vec::new()),
-                |(ball, nb), v| {
-                    neighbours(mesh, v, ball, nb);
-                    if nb.is_empty() {
-                        return 0.0;
+                |(ball, nb), k| {
+                    let vs = k * BLOCK..((k + 1) * BLOCK).min(n);
+                    let mut means = Vec::with_capacity(vs.len());
+                    let mut ends = Vec::with_capacity(vs.len());
+                    let mut upper = Vec::new();
+                    for v in vs {
+                        neighbours(mesh, v, ball, nb);
+                        let p = mesh.point(v);
+                        let mut sum = 0.0;
+                        for &u in nb.iter() {
+                            let l = p.distance(mesh.point(u));
+                            sum += l;
+                            if u > v {
+                                upper.push((u, l));
+                            }
+                        }
+                        means.push(if nb.is_empty() {
+                            0.0
+                        } else {
+                            sum / nb.len() as f64
+                        });
+                        ends.push(upper.len() as u32);
                     }
-                    let p = mesh.point(v);
-                    nb.iter().map(|&u| p.distance(mesh.point(u))).sum::<f64>() / nb.len() as f64
+                    (means, ends, upper)
                 },
             )
             .collect()
     };
+    let mean_len: Vec<f64> = blocks.iter().flat_map(|b| b.0.iter().copied()).collect();
     let mut long: Vec<(f64, u32, u32)> = {
         let mesh = &*mesh;
         let mean_len = &mean_len;
         let zone = &zone;
         let fixed = &fixed;
-        (0..n)
-            .into_par_iter()
-            .with_min_len(1024)
-            .map_init(
-                || (Vec::new(), Vec::new(), Vec::new()),
-                |(ball, nb, sh), a| {
-                    neighbours(mesh, a, ball, nb);
-                    let pa = mesh.point(a);
-                    let mut found = Vec::new();
-                    for &b in nb.iter().filter(|&&b| b > a) {
-                        let l = pa.distance(mesh.point(b));
+        blocks
+            .par_iter()
+            .enumerate()
+            .map_init(Vec::new, |sh, (k, (_, ends, upper))| {
+                let mut found = Vec::new();
+                let mut from = 0;
+                for (i, &end) in ends.iter().enumerate() {
+                    let a = k as u32 * BLOCK + i as u32;
+                    for &(b, l) in &upper[from..end as usize] {
                         let local = 0.5 * (mean_len[a as usize] + mean_len[b as usize]);
                         if l > factor * local && !(fixed[a as usize] && fixed[b as usize]) {
                             shell(mesh, a, b, sh);
@@ -143,12 +167,14 @@ pub(crate) fn split_long_edges(
                             }
                         }
                     }
-                    found
-                },
-            )
+                    from = end as usize;
+                }
+                found
+            })
             .flatten_iter()
             .collect()
     };
+    drop(blocks);
     long.sort_unstable_by(|x, y| y.0.total_cmp(&x.0).then((x.1, x.2).cmp(&(y.1, y.2))));
     let mut new_tets = Vec::new();
     let mut splits = 0;

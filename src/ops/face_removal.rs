@@ -541,7 +541,10 @@ mod tests {
             }
         }
         // The fixture must exercise both outcomes.
-        assert!(plans > 0 && refusals > 0, "{plans} plans, {refusals} refusals");
+        assert!(
+            plans > 0 && refusals > 0,
+            "{plans} plans, {refusals} refusals"
+        );
     }
 
     #[test]
