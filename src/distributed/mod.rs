@@ -222,7 +222,14 @@ pub fn refine_distributed(
                 opts.steps,
             );
             let band = zone.1.iter().filter(|&&b| b).count() as u64;
-            crate::refine::step::optimize_phase(&mut local.mesh, opts.steps, &o, false, Some(zone));
+            crate::refine::step::optimize_phase(
+                &mut local.mesh,
+                opts.steps,
+                &o,
+                false,
+                Some(zone),
+                0.0,
+            );
             let c = census(comm, &local.mesh)?;
             last = Some((c, global_stats(comm, &local.mesh, &c)?));
             let band = comm.sum(&[band])[0];

@@ -76,7 +76,18 @@ pub struct ImproveOptions {
     /// the flips and contractions of a pass, where that raises the worst tet
     /// of the edge's shell (see `insert_pass`); the tet count grows.
     pub insert_vertices: bool,
+    /// The quality (min sine) the passes should leave every tet at or
+    /// above: while a tet that may change is below it, passes go on past
+    /// `passes`, at most [`FLOOR_PASSES`] more, as long as each raises the
+    /// worst of them and changes something. A refinement step sets it from
+    /// its input's worst tet (so that a refined mesh is not worse than its
+    /// input); 0: none.
+    pub floor: f64,
 }
+
+/// Passes [`improve`] runs at most past [`ImproveOptions::passes`] while a
+/// tet is below [`ImproveOptions::floor`].
+pub const FLOOR_PASSES: usize = 4;
 
 impl Default for ImproveOptions {
     fn default() -> Self {
@@ -93,6 +104,7 @@ impl Default for ImproveOptions {
             long_edge_factor: None,
             long_edge_zone: None,
             insert_vertices: true,
+            floor: 0.0,
         }
     }
 }
@@ -223,6 +235,16 @@ impl Tracker {
         }
     }
 
+    /// The worst quality of the live tets that may change (+∞ if none).
+    fn worst_allowed(&self, mesh: &TetMesh) -> f64 {
+        (0..mesh.n_tet_slots() as u32)
+            .into_par_iter()
+            .with_min_len(4096)
+            .filter(|&t| mesh.is_alive(t) && self.is_allowed(t))
+            .map(|t| self.tq[t as usize])
+            .reduce(|| f64::INFINITY, f64::min)
+    }
+
     /// The live tets that may change whose quality is below `bar`, in slot
     /// order.
     fn allowed_below(&self, mesh: &TetMesh, bar: f64) -> Vec<u32> {
@@ -283,7 +305,17 @@ pub fn improve(mesh: &mut TetMesh, opts: &ImproveOptions) -> ImproveReport {
         .boundary
         .as_ref()
         .map(|b| BoundarySmoother::new(mesh, b.clone()));
-    for pass in 0..opts.passes {
+    // Past `opts.passes`, a pass runs only while a tet is below the floor
+    // and the one before raised the worst of those that may change.
+    let mut worst = f64::NEG_INFINITY;
+    for pass in 0..opts.passes + FLOOR_PASSES {
+        if pass >= opts.passes {
+            let now = tr.worst_allowed(mesh);
+            if now >= opts.floor || now <= worst {
+                break;
+            }
+            worst = now;
+        }
         report.passes += 1;
         let mut changed = edges.pass(mesh, &mut tr, opts, &mut report);
         changed += face_pass(mesh, &mut tr, &edges.examined, &movable, opts, &mut report);
