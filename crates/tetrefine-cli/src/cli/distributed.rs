@@ -144,7 +144,7 @@ pub fn run(a: Args) -> super::CliResult {
             stop_after: a.stop_after,
             selection: None,
             smooth_refined_only: first_selection.is_some() && a.smooth == SmoothScope::Refined,
-            step_offset: a.step_offset,
+            step_offset: super::refine::step_offset(&a),
             check_each_phase: false,
             effort: a.effort,
             hausd: a.hausd,

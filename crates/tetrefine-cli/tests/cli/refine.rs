@@ -116,3 +116,58 @@ fn bad_options_fail_before_any_work() {
         assert!(!out.exists(), "{args:?} left output");
     }
 }
+
+/// A `.vtu` tetrefine wrote carries each tet's `level`: refining it again
+/// continues the global step count, so its feature edges are trisected in
+/// the second step (three times as many, the √3 scheme's even-step rule)
+/// instead of kept, and the worst angle stays at least the input's;
+/// `--step-offset 0` starts the count over (the edges kept).
+#[test]
+fn refining_a_refined_vtu_continues_its_step_count() {
+    let dir = tempfile::tempdir().unwrap();
+    let first = dir.path().join("t1.vtu");
+    let stats = |name: &str| -> serde_json::Value {
+        let text = std::fs::read_to_string(dir.path().join(name)).unwrap();
+        serde_json::from_str(&text).unwrap()
+    };
+    let path = |name: &str| dir.path().join(name).to_str().unwrap().to_string();
+    run(&["refine", "meshes/tripod.mesh", "-o", &path("t1.vtu")]);
+    let o = run(&[
+        "refine",
+        first.to_str().unwrap(),
+        "-o",
+        &path("t2.vtu"),
+        "--stats",
+        &path("s2.json"),
+    ]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("has had 1 refinement step"), "{err}");
+    run(&[
+        "refine",
+        first.to_str().unwrap(),
+        "-o",
+        &path("t0.vtu"),
+        "--stats",
+        &path("s0.json"),
+        "--step-offset",
+        "0",
+    ]);
+    let (s2, s0) = (stats("s2.json"), stats("s0.json"));
+    let features =
+        |s: &serde_json::Value, k: usize| s["steps"][k]["feature_edges"].as_u64().unwrap();
+    let worst = |s: &serde_json::Value, k: usize| {
+        s["steps"][k]["min_dihedral_deg"]["worst"].as_f64().unwrap()
+    };
+    assert_eq!(
+        features(&s2, 1),
+        3 * features(&s2, 0),
+        "continued: trisected"
+    );
+    assert_eq!(features(&s0, 1), features(&s0, 0), "started over: kept");
+    assert!(
+        worst(&s2, 1) >= worst(&s2, 0),
+        "worst {} below the input's {}",
+        worst(&s2, 1),
+        worst(&s2, 0)
+    );
+}
