@@ -36,7 +36,7 @@ mod partition;
 
 pub use comm::{failure_printed, Comm, OTHER_RANK_FAILED};
 pub use cut::{census, global_point_ids, global_stats, Census};
-pub use part::{MarkerSlots, Part};
+pub use part::{MarkerSlots, Part, Reader, Wire};
 pub use partition::partition_dual_graph;
 
 use crate::mesh::partition::PartitionMarker;

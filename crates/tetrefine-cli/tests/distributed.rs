@@ -587,22 +587,139 @@ fn a_gathered_output_carries_fields_and_the_parent_map() {
         }
         assert_eq!(n, mesh.n_points());
     }
-    // A .pvtu cannot carry them: refused by name, nothing written.
+}
+
+/// The `.vtu` files a `.pvtu` lists, in its order.
+fn piece_sources(pvtu: &Path) -> Vec<PathBuf> {
+    std::fs::read_to_string(pvtu)
+        .unwrap()
+        .lines()
+        .filter_map(|l| l.trim().strip_prefix("<Piece Source=\""))
+        .map(|l| pvtu.with_file_name(l.trim_end_matches("\"/>")))
+        .collect()
+}
+
+#[test]
+fn pieces_carry_fields_and_their_own_parent_maps() {
+    // Two ranks, a .pvtu output with a linear point field and a cell field
+    // from Medit solutions and --parent-map: every piece carries the field
+    // exactly at each of its points (linear interpolation reproduces a
+    // linear field), each tet the cell value of its parent, which holds the
+    // tet's centroid, and each piece's map (in its own numbering) gives
+    // every point as a barycentric combination of input points.
+    let dir = tempfile::tempdir().unwrap();
+    let tripod = input("meshes/tripod.mesh");
+    let pts: Vec<[f64; 3]> = tripod.points().iter().map(|p| p.to_array()).collect();
+    let fp = dir.path().join("f.sol");
+    let rows: Vec<Vec<f64>> = pts.iter().map(|&p| vec![field(p)]).collect();
+    support::write_sol(&fp, "SolAtVertices", &[1], &rows);
+    let cp = dir.path().join("cells.sol");
+    let rows: Vec<Vec<f64>> = (0..tripod.n_tets()).map(|t| vec![1.5 * t as f64]).collect();
+    support::write_sol(&cp, "SolAtTetrahedra", &[1], &rows);
     let out = dir.path().join("o.pvtu");
-    let o = mpirun(
+    let map = dir.path().join("map.txt");
+    let o = mpirun_ok(
         2,
         &[
             "refine",
             "meshes/tripod.mesh",
             "-o",
             out.to_str().unwrap(),
+            "--boundary",
+            "linear",
             "--fields",
             fp.to_str().unwrap(),
+            "--fields",
+            cp.to_str().unwrap(),
+            "--parent-map",
+            map.to_str().unwrap(),
         ],
     );
-    assert!(!o.status.success());
-    assert!(String::from_utf8_lossy(&o.stderr).contains("--fields"));
-    assert!(!out.exists());
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("transfer: 1 point and 1 cell fields"), "{err}");
+    assert!(!map.exists(), "one map per piece, none for the whole");
+    let (union, _) = union_of_pieces(&out);
+    let pvtu = std::fs::read_to_string(&out).unwrap();
+    for name in ["f", "cells", "parent_tet", "parent_bary", "parent_vertices"] {
+        assert!(pvtu.contains(&format!("Name=\"{name}\"")), "{name}: {pvtu}");
+    }
+    // Whether input tet `t` holds `x` (a relative tolerance for round-off).
+    let holds = |t: u32, x: glam::DVec3| {
+        let p = tripod.tet_points(t);
+        let v = tet_volume(&p);
+        (0..4).all(|k| {
+            let mut q = p;
+            q[k] = x;
+            tet_volume(&q) >= -1e-9 * v
+        })
+    };
+    let sources = piece_sources(&out);
+    assert_eq!(sources.len(), 2);
+    let (mut tets, mut points) = (0, 0);
+    for (r, s) in sources.iter().enumerate() {
+        let (d, meta) = tetrefine::io::read_mesh_with_meta(s).unwrap();
+        let f = meta.point_fields.iter().find(|f| f.name == "f").unwrap();
+        for (i, p) in d.points.iter().enumerate() {
+            assert!(
+                (f.values[i] - field(*p)).abs() <= 1e-9,
+                "piece {r}, point {i}: {} vs {}",
+                f.values[i],
+                field(*p)
+            );
+        }
+        let parent = tetrefine::io::read_tet_cell_array(s, "parent")
+            .unwrap()
+            .values;
+        let cells = meta.cell_fields.iter().find(|f| f.name == "cells").unwrap();
+        assert_eq!(parent.len(), d.tets.len());
+        for (t, tet) in d.tets.iter().enumerate() {
+            assert_eq!(cells.values[t], 1.5 * parent[t], "piece {r}, tet {t}");
+            let c = tet
+                .iter()
+                .map(|&v| glam::DVec3::from_array(d.points[v as usize]))
+                .sum::<glam::DVec3>()
+                / 4.0;
+            assert!(holds(parent[t] as u32, c), "piece {r}, tet {t}");
+        }
+        // The piece's map, named like the piece: its tets' parents, then
+        // each point as its line's combination of input points.
+        let text = std::fs::read_to_string(dir.path().join(format!("map_{r}.txt"))).unwrap();
+        let (tet_lines, point_lines) = text.split_once("# points").expect("a points section");
+        let listed: Vec<f64> = tet_lines
+            .lines()
+            .filter(|l| !l.starts_with('#') && !l.trim().is_empty())
+            .map(|l| l.split_whitespace().nth(1).unwrap().parse().unwrap())
+            .collect();
+        assert_eq!(listed, parent, "piece {r}");
+        let mut n = 0;
+        for l in point_lines.lines().skip(1).filter(|l| !l.trim().is_empty()) {
+            let v: Vec<f64> = l.split_whitespace().map(|x| x.parse().unwrap()).collect();
+            assert_eq!(v[0] as usize, n, "piece {r}: 0-based, in order");
+            // (A point on the boundary may round to just outside the
+            // input: its nearest boundary point, within round-off.)
+            let corners = tripod.tet(v[1] as u32);
+            let mut x = [0.0; 3];
+            for k in 0..4 {
+                assert_eq!(v[2 + k] as u32, corners[k], "piece {r}, point {n}");
+                let q = pts[corners[k] as usize];
+                for a in 0..3 {
+                    x[a] += v[6 + k] * q[a];
+                }
+            }
+            for (xa, pa) in x.iter().zip(d.points[n]) {
+                assert!((xa - pa).abs() <= 1e-9, "piece {r}, point {n}");
+            }
+            n += 1;
+        }
+        assert_eq!(n, d.points.len(), "piece {r}");
+        tets += d.tets.len();
+        points += d.points.len();
+    }
+    assert_eq!(tets, union.n_tets());
+    assert!(
+        points > union.n_points(),
+        "the cut's points are in both pieces"
+    );
 }
 
 /// Area of the marked faces (boundary and interior), per marker.

@@ -9,6 +9,8 @@ pub mod guard;
 pub mod improve;
 pub mod mesh;
 pub mod outputs;
+#[cfg(feature = "mpi")]
+pub mod piece_fields;
 pub mod progress;
 pub mod quality;
 pub mod refine;
