@@ -6,6 +6,7 @@
 //! input it kept, `--parent-map`, `--fields`/`--transfer`, `marked`). With
 //! pieces, `--parent-map` and the fields come from rank 0 too, one piece at
 //! a time ([`super::piece_fields`]); each rank writes its own.
+//! A `.pvtu` input is read per rank instead ([`super::pvtu_input`]).
 //! Rank 0 prints the step table of the whole mesh; every file appears only
 //! when every rank succeeded.
 
@@ -73,6 +74,10 @@ fn refuse_serial_only(a: &Args) -> super::CliResult {
 pub fn run(a: Args) -> super::CliResult {
     refuse_serial_only(&a)?;
     let pieces = is_pvtu(&a.output);
+    let pvtu_in = is_pvtu(&a.input);
+    if pvtu_in {
+        super::pvtu_input::refuse_unsupported(&a)?;
+    }
     if !pieces {
         tetrefine::io::Format::for_writing(&a.output).map_err(|e| e.to_string())?;
     }
@@ -98,31 +103,45 @@ pub fn run(a: Args) -> super::CliResult {
     let (_universe, comm) = dist::init()?;
     let t0 = Instant::now();
     let root = comm.rank == 0;
-    // Rank 0 reads; its failure (a bad file) ends every rank.
-    let loaded = if root {
-        load_on_root(&a, strategy.as_ref())
-    } else {
-        Ok(None)
-    };
-    let loaded = comm.agree(loaded)?;
-    let (mut input, meta, selection, transfer) = match loaded {
-        Some((m, meta, s, t)) => (Some(m), meta, s, t),
-        None => (None, Default::default(), None, false),
-    };
     let mut steps = Vec::new();
-    if let Some(m) = &input {
-        let first = MeshStats::compute(m);
-        crate::say!("{}", step_table_header());
-        crate::say!("{}", step_row("input", &first, 0.0));
-        steps.push(StepStats::input(first));
-        eprintln!(
-            "distributing {} tets over {} ranks (METIS)",
-            m.n_tets(),
-            comm.size
-        );
-    }
-    let (mut local, first_selection) =
-        dist::distribute(&comm, input.as_ref(), selection.as_deref(), n_steps)?;
+    let (mut input, meta, selection, transfer, mut local, first_selection) = if pvtu_in {
+        // Every rank reads its own pieces; nobody holds the whole input.
+        let local = super::pvtu_input::load_pieces(&comm, &a)?;
+        let c = dist::census(&comm, &local.mesh)?;
+        let first = dist::global_stats(&comm, &local.mesh, &c)?;
+        if root {
+            crate::say!("{}", step_table_header());
+            crate::say!("{}", step_row("input", &first, 0.0));
+            steps.push(StepStats::input(first));
+        }
+        (None, Default::default(), None, false, local, None)
+    } else {
+        // Rank 0 reads; its failure (a bad file) ends every rank.
+        let loaded = if root {
+            load_on_root(&a, strategy.as_ref())
+        } else {
+            Ok(None)
+        };
+        let loaded = comm.agree(loaded)?;
+        let (input, meta, selection, transfer) = match loaded {
+            Some((m, meta, s, t)) => (Some(m), meta, s, t),
+            None => (None, Default::default(), None, false),
+        };
+        if let Some(m) = &input {
+            let first = MeshStats::compute(m);
+            crate::say!("{}", step_table_header());
+            crate::say!("{}", step_row("input", &first, 0.0));
+            steps.push(StepStats::input(first));
+            eprintln!(
+                "distributing {} tets over {} ranks (METIS)",
+                m.n_tets(),
+                comm.size
+            );
+        }
+        let (local, first_selection) =
+            dist::distribute(&comm, input.as_ref(), selection.as_deref(), n_steps)?;
+        (input, meta, selection, transfer, local, first_selection)
+    };
     // Pieces are located in the input (on rank 0) only for the parent map
     // and the fields; a gathered output always is, as the serial one.
     let locate = a.parent_map.is_some() || comm.sum(&[u64::from(transfer)])[0] > 0;

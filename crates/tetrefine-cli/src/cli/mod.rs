@@ -12,6 +12,8 @@ pub mod outputs;
 #[cfg(feature = "mpi")]
 pub mod piece_fields;
 pub mod progress;
+#[cfg(feature = "mpi")]
+pub mod pvtu_input;
 pub mod quality;
 pub mod refine;
 pub mod size;
