@@ -115,9 +115,10 @@ fn names(pieces: &[(usize, &PathBuf)]) -> String {
 type PointIds = Vec<(Option<u64>, usize)>;
 
 /// This rank's pieces as one mesh: points shared by `GlobalPointIds` when
-/// every piece has them, else by exact coordinates. A piece that cannot be
-/// read, holds an inverted tet, or gives one id to two points (or two ids
-/// to one point) is an error naming it.
+/// every piece has them (and by exact coordinates: equal coordinates are
+/// one point), else by exact coordinates alone. A piece that cannot be
+/// read, holds an inverted tet, or gives one id to two points is an error
+/// naming it.
 fn merge_pieces(pieces: &[(usize, &PathBuf)]) -> Result<(MeshData, PointIds), String> {
     let mut read = Vec::with_capacity(pieces.len());
     for &(i, path) in pieces {
@@ -171,25 +172,31 @@ fn merge_pieces(pieces: &[(usize, &PathBuf)]) -> Result<(MeshData, PointIds), St
             let g = gids.as_ref().map(|g| g[v]);
             let next = out.points.len() as u32;
             let at = match (by_id, g) {
-                (true, Some(g)) => {
-                    let at = *by_gid.entry(g).or_insert(next);
-                    let k = *by_key.entry(key(x)).or_insert(at);
-                    if k != at || (at != next && out.points[at as usize] != x) {
-                        let earlier = if k != next { k } else { at };
-                        let other = ids
-                            .get(earlier as usize)
-                            .and_then(|&(_, j)| pieces.iter().find(|(i, _)| *i == j))
+                (true, Some(g)) => match by_gid.get(&g) {
+                    Some(&at) if out.points[at as usize] != x => {
+                        let other = pieces
+                            .iter()
+                            .find(|(j, _)| *j == ids[at as usize].1)
                             .map_or_else(
                                 || "this piece".to_string(),
                                 |(_, p)| p.display().to_string(),
                             );
                         return Err(format!(
-                            "{}: GlobalPointIds {g} at {x:?} disagrees with {other} (one id for two points, or two ids for one point)",
-                            path.display()
+                            "{}: GlobalPointIds {g} names {x:?} here and {:?} in {other}",
+                            path.display(),
+                            out.points[at as usize]
                         ));
                     }
-                    at
-                }
+                    Some(&at) => at,
+                    None => {
+                        // Equal coordinates are one point even under two
+                        // ids: a point two ranks share without a shared
+                        // face (a pinch) gets an id from each.
+                        let at = *by_key.entry(key(x)).or_insert(next);
+                        by_gid.insert(g, at);
+                        at
+                    }
+                },
                 _ => *by_key.entry(key(x)).or_insert(next),
             };
             if at == next {
@@ -224,57 +231,35 @@ fn merge_pieces(pieces: &[(usize, &PathBuf)]) -> Result<(MeshData, PointIds), St
     Ok((out, ids))
 }
 
-/// Across ranks: every `GlobalPointIds` value names one point, and every
-/// point has one id. Each (id, point) pair goes to the rank its id names
-/// and to the rank its coordinates name (a fixed hash); there, an id seen
-/// with two points, or a point with two ids, is an error naming the pieces
-/// that disagree.
+/// Across ranks: every `GlobalPointIds` value names one point. Each
+/// (id, point) pair goes to the rank its id names (modulo the rank count);
+/// there, an id seen with two different points is an error naming the
+/// pieces that disagree. (Two ids for one point are not an error: a point
+/// two ranks share without a shared face gets one from each.)
 fn check_point_ids(
     comm: &Comm,
     all: &[PathBuf],
     data: &MeshData,
     ids: &[(Option<u64>, usize)],
 ) -> super::CliResult {
-    let size = u64::from(comm.size);
     let mut out: Vec<Wire> = (0..comm.size).map(|_| Wire::default()).collect();
     for (x, &(g, piece)) in data.points.iter().zip(ids) {
         let Some(g) = g else { continue };
-        let k = dist::point_key(glam::DVec3::from_array(*x));
-        let by_key = k.iter().fold(0u64, |h, &c| h.rotate_left(17) ^ c);
-        for (kind, to) in [(0u32, g % size), (1, by_key % size)] {
-            let w = &mut out[to as usize];
-            w.u32(kind);
-            w.u64(g);
-            w.key(&k);
-            w.u64(piece as u64);
-        }
+        let w = &mut out[(g % u64::from(comm.size)) as usize];
+        w.u64(g);
+        w.key(&dist::point_key(glam::DVec3::from_array(*x)));
+        w.u64(piece as u64);
     }
     let got = comm.exchange(out.into_iter().map(|w| w.0).collect())?;
-    let mut by_id: std::collections::HashMap<u64, ([u64; 3], u64)> = Default::default();
-    let mut by_point: std::collections::HashMap<[u64; 3], (u64, u64)> = Default::default();
+    let mut seen: std::collections::HashMap<u64, ([u64; 3], u64)> = Default::default();
     let mut bad = None;
     for bytes in &got {
         let mut r = Reader { bytes, at: 0 };
         while !r.done() && bad.is_none() {
-            let (kind, g, k, piece) = (r.u32()?, r.u64()?, r.key()?, r.u64()?);
-            if kind == 0 {
-                let (k0, p0) = *by_id.entry(g).or_insert((k, piece));
-                if k0 != k {
-                    bad = Some((
-                        format!("GlobalPointIds {g} names two different points"),
-                        p0,
-                        piece,
-                    ));
-                }
-            } else {
-                let (g0, p0) = *by_point.entry(k).or_insert((g, piece));
-                if g0 != g {
-                    bad = Some((
-                        format!("one point has GlobalPointIds {g0} and {g}"),
-                        p0,
-                        piece,
-                    ));
-                }
+            let (g, k, piece) = (r.u64()?, r.key()?, r.u64()?);
+            let (k0, p0) = *seen.entry(g).or_insert((k, piece));
+            if k0 != k {
+                bad = Some((g, p0, piece));
             }
         }
     }
@@ -283,8 +268,15 @@ fn check_point_ids(
             .map_or_else(|| format!("piece {i}"), |p| p.display().to_string())
     };
     comm.agree(match bad {
-        Some((what, a, b)) if a == b => Err(format!("{}: {what}", piece(a))),
-        Some((what, a, b)) => Err(format!("{} and {}: {what}", piece(a), piece(b))),
+        Some((g, a, b)) if a == b => Err(format!(
+            "{}: GlobalPointIds {g} names two different points",
+            piece(a)
+        )),
+        Some((g, a, b)) => Err(format!(
+            "{} and {}: GlobalPointIds {g} names two different points",
+            piece(a),
+            piece(b)
+        )),
         None => Ok(()),
     })
 }
