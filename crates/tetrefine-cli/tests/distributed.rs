@@ -732,6 +732,73 @@ fn pieces_carry_fields_and_their_own_parent_maps() {
         points > union.n_points(),
         "the cut's points are in both pieces"
     );
+
+    // That .pvtu as an input carries its fields on: read whole by the
+    // serial command and by rank 0 of a gathered run, the linear field is
+    // exact at every output point and each tet's cell value is that of its
+    // parent, numbered piece after piece.
+    let mut input_cells = Vec::new();
+    for s in &sources {
+        let (_, meta) = tetrefine::io::read_mesh_with_meta(s).unwrap();
+        let c = meta.cell_fields.iter().find(|f| f.name == "cells").unwrap();
+        input_cells.extend_from_slice(&c.values);
+    }
+    let serial = dir.path().join("serial.vtu");
+    serial_ok(&[
+        "refine",
+        out.to_str().unwrap(),
+        "-o",
+        serial.to_str().unwrap(),
+        "--boundary",
+        "linear",
+    ]);
+    let gathered = dir.path().join("gathered.vtu");
+    mpirun_ok(
+        2,
+        &[
+            "refine",
+            out.to_str().unwrap(),
+            "-o",
+            gathered.to_str().unwrap(),
+            "--boundary",
+            "linear",
+        ],
+    );
+    for file in [&serial, &gathered] {
+        let (d, meta) = tetrefine::io::read_mesh_with_meta(file).unwrap();
+        let f = meta.point_fields.iter().find(|f| f.name == "f").unwrap();
+        for (i, p) in d.points.iter().enumerate() {
+            assert!(
+                (f.values[i] - field(*p)).abs() <= 1e-9,
+                "{file:?}, point {i}"
+            );
+        }
+        let parent = tetrefine::io::read_tet_cell_array(file, "parent")
+            .unwrap()
+            .values;
+        let cells = meta.cell_fields.iter().find(|f| f.name == "cells").unwrap();
+        for (t, &p) in parent.iter().enumerate() {
+            assert_eq!(
+                cells.values[t], input_cells[p as usize],
+                "{file:?}, tet {t}"
+            );
+        }
+    }
+    // Read per rank into pieces, the fields cannot follow: refused with
+    // the way out, which then works.
+    let again = dir.path().join("again.pvtu");
+    let args = [
+        "refine",
+        out.to_str().unwrap(),
+        "-o",
+        again.to_str().unwrap(),
+    ];
+    let o = mpirun(2, &args);
+    assert!(!o.status.success());
+    assert!(String::from_utf8_lossy(&o.stderr).contains("--no-transfer"));
+    assert!(!again.exists());
+    mpirun_ok(2, &[&args[..], &["--no-transfer"]].concat());
+    assert_eq!(piece_sources(&again).len(), 2);
 }
 
 /// Area of the marked faces (boundary and interior), per marker.
@@ -1030,31 +1097,6 @@ fn a_bad_pvtu_piece_ends_every_rank_naming_the_file() {
     };
     // Fewer pieces than ranks.
     fails(3, "3 ranks", &["a.pvtu", "2 pieces for 3 ranks"]);
-    // What needs the whole input on one rank is refused by name.
-    let map = dir.path().join("map.txt");
-    let gathered = dir.path().join("g.vtu");
-    for (args, name) in [
-        (
-            vec!["-o".to_string(), s(&out), "--parent-map".into(), s(&map)],
-            "--parent-map",
-        ),
-        (vec!["-o".to_string(), s(&gathered)], "a .pvtu input"),
-    ] {
-        let o = mpirun(
-            2,
-            &[&["refine".to_string(), s(&a)][..], &args[..]]
-                .concat()
-                .iter()
-                .map(String::as_str)
-                .collect::<Vec<_>>(),
-        );
-        assert!(!o.status.success(), "{name}");
-        assert!(String::from_utf8_lossy(&o.stderr).contains(name), "{name}");
-        assert!(
-            !out.exists() && !map.exists() && !gathered.exists(),
-            "{name}"
-        );
-    }
     // GlobalPointIds that disagree between the pieces: piece 1's shifted
     // by one, so an id names another point than in piece 0.
     let good = std::fs::read(&pieces[1]).unwrap();

@@ -6,7 +6,8 @@
 //! input it kept, `--parent-map`, `--fields`/`--transfer`, `marked`). With
 //! pieces, `--parent-map` and the fields come from rank 0 too, one piece at
 //! a time ([`super::piece_fields`]); each rank writes its own.
-//! A `.pvtu` input is read per rank instead ([`super::pvtu_input`]).
+//! A `.pvtu` input with a `.pvtu` output is read per rank instead
+//! ([`super::pvtu_input`]).
 //! Rank 0 prints the step table of the whole mesh; every file appears only
 //! when every rank succeeded.
 
@@ -74,10 +75,7 @@ fn refuse_serial_only(a: &Args) -> super::CliResult {
 pub fn run(a: Args) -> super::CliResult {
     refuse_serial_only(&a)?;
     let pieces = is_pvtu(&a.output);
-    let pvtu_in = is_pvtu(&a.input);
-    if pvtu_in {
-        super::pvtu_input::refuse_unsupported(&a)?;
-    }
+    let pvtu_in = super::pvtu_input::per_rank(&a);
     if !pieces {
         tetrefine::io::Format::for_writing(&a.output).map_err(|e| e.to_string())?;
     }

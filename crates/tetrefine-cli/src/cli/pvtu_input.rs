@@ -1,5 +1,5 @@
-//! A `.pvtu` input of a distributed `refine`: every rank reads its own
-//! pieces (the pieces in contiguous blocks: with K pieces on P ranks, rank
+//! A `.pvtu` input of a distributed `refine` with a `.pvtu` output (see
+//! [`per_rank`]): every rank reads its own pieces (the pieces in contiguous blocks: with K pieces on P ranks, rank
 //! r reads pieces ⌊rK/P⌋ to ⌊(r+1)K/P⌋ − 1; fewer pieces than ranks is an
 //! error), merges them (shared points by `GlobalPointIds` when every piece
 //! carries them, else by exact coordinates), detects its features, and
@@ -11,36 +11,23 @@ use std::path::PathBuf;
 use tetrefine::distributed::{self as dist, Comm, LocalMesh, Reader, Wire};
 use tetrefine::MeshData;
 
-/// The options a `.pvtu` input cannot serve yet, refused by name: those
-/// that need the whole input on one rank (a gathered output, the parent
-/// map, the fields, a selection, an edge list in input numbering).
-pub fn refuse_unsupported(a: &Args) -> super::CliResult {
-    if !super::distributed::is_pvtu(&a.output) {
-        return Err(format!(
-            "{}: a .pvtu input is read piece by piece on every rank and refined into a .pvtu output; give -o OUT.pvtu",
-            a.input.display()
-        ));
-    }
-    let refused = [
-        ("--parent-map", a.parent_map.is_some()),
-        ("--fields", !a.fields.is_empty()),
-        ("--transfer", a.transfer),
-        ("--indicator", a.indicator.is_some()),
-        ("--mark", !a.marks.is_empty()),
-        ("--region", a.region.is_some()),
-        ("--box", a.select_box.is_some()),
-        ("--sphere", a.sphere.is_some()),
-        (
-            "--features FILE",
-            !matches!(a.features.as_str(), "auto" | "none"),
-        ),
-    ];
-    match refused.iter().find(|(_, on)| *on) {
-        Some((name, _)) => Err(format!(
-            "{name} is not available with a .pvtu input (no rank holds the whole input); refine the pieces uniformly, or give a single-file input"
-        )),
-        None => Ok(()),
-    }
+/// Whether a distributed run reads its `.pvtu` input per rank: with a
+/// `.pvtu` output and none of the options that need the whole input on one
+/// rank (a gathered output, `--parent-map`, `--fields`, `--transfer`, a
+/// selection, `--features FILE`); otherwise rank 0 reads every piece and
+/// METIS partitions, as for any input.
+pub fn per_rank(a: &Args) -> bool {
+    super::distributed::is_pvtu(&a.input)
+        && super::distributed::is_pvtu(&a.output)
+        && a.parent_map.is_none()
+        && a.fields.is_empty()
+        && !a.transfer
+        && a.indicator.is_none()
+        && a.marks.is_empty()
+        && a.region.is_none()
+        && a.select_box.is_none()
+        && a.sphere.is_none()
+        && matches!(a.features.as_str(), "auto" | "none")
 }
 
 /// Every rank's share of the `.pvtu` input `a.input`, with its cut faces
@@ -65,11 +52,29 @@ pub fn load_pieces(comm: &Comm, a: &Args) -> Result<LocalMesh, String> {
         .skip((r * k / p) as usize)
         .take(((r + 1) * k / p - r * k / p) as usize)
         .collect();
-    let read = merge_pieces(&mine);
-    let (data, ids) = comm.agree(read)?;
+    let read = super::pvtu_merge::merge_pieces(&mine);
+    let (data, ids, fields) = comm.agree(read)?;
+    // A rank holds its own pieces only: it could not interpolate their
+    // fields at points that the cut move brings from another rank.
+    let names: Vec<&str> = fields
+        .point_fields
+        .iter()
+        .chain(&fields.cell_fields)
+        .map(|f| f.name.as_str())
+        .collect();
+    let with_fields = comm.sum(&[u64::from(!names.is_empty())])[0] > 0;
+    comm.agree(if with_fields && !a.no_transfer && comm.rank == 0 {
+        Err(format!(
+            "{}: the pieces carry fields ({}) that a per-rank read does not carry over: give --no-transfer to drop them, or a single-file -o (rank 0 then reads every piece and carries them over)",
+            a.input.display(),
+            if names.is_empty() { "on other ranks".to_string() } else { names.join(", ") }
+        ))
+    } else {
+        Ok(())
+    })?;
     check_point_ids(comm, &all, &data, &ids)?;
     let built = tetrefine::TetMesh::from_data(&data)
-        .map_err(|e| format!("{}: {e}", names(&mine)))
+        .map_err(|e| format!("{}: {e}", super::pvtu_merge::names(&mine)))
         .map(|(mut mesh, _)| {
             // Quietly: a rank's counts are not the input's (the step
             // table's input row gives the union's).
@@ -99,136 +104,6 @@ pub fn load_pieces(comm: &Comm, a: &Args) -> Result<LocalMesh, String> {
         );
     }
     dist::assemble(comm, mesh, first as u32)
-}
-
-/// The names of `pieces`, for a message.
-fn names(pieces: &[(usize, &PathBuf)]) -> String {
-    pieces
-        .iter()
-        .map(|(_, p)| p.display().to_string())
-        .collect::<Vec<_>>()
-        .join(", ")
-}
-
-/// Per merged point: its `GlobalPointIds` value (when the pieces carry
-/// them) and the index of the piece it was first read from.
-type PointIds = Vec<(Option<u64>, usize)>;
-
-/// This rank's pieces as one mesh: points shared by `GlobalPointIds` when
-/// every piece has them (and by exact coordinates: equal coordinates are
-/// one point), else by exact coordinates alone. A piece that cannot be
-/// read, holds an inverted tet, or gives one id to two points is an error
-/// naming it.
-fn merge_pieces(pieces: &[(usize, &PathBuf)]) -> Result<(MeshData, PointIds), String> {
-    let mut read = Vec::with_capacity(pieces.len());
-    for &(i, path) in pieces {
-        let (d, meta) = tetrefine::io::read_mesh_with_meta(path).map_err(|e| e.to_string())?;
-        let gids = match meta
-            .point_fields
-            .iter()
-            .find(|f| f.name == "GlobalPointIds")
-        {
-            Some(f) if f.components == 1 => Some(
-                f.values
-                    .iter()
-                    .map(|&g| {
-                        (g >= 0.0 && g.fract() == 0.0)
-                            .then_some(g as u64)
-                            .ok_or_else(|| {
-                                format!("{}: GlobalPointIds holds {g}, not an id", path.display())
-                            })
-                    })
-                    .collect::<Result<Vec<u64>, String>>()?,
-            ),
-            Some(_) => {
-                return Err(format!(
-                    "{}: GlobalPointIds has more than one component",
-                    path.display()
-                ))
-            }
-            None => None,
-        };
-        if let Some(t) = d.tets.iter().position(|t| {
-            let q = t.map(|v| glam::DVec3::from_array(d.points[v as usize]));
-            tetrefine::geom::tet_volume(&q) < 0.0
-        }) {
-            return Err(format!(
-                "{}: tetrahedron {} is inverted (negative volume): a corrupt piece",
-                path.display(),
-                t + 1
-            ));
-        }
-        read.push((i, path, d, gids));
-    }
-    let by_id = read.iter().all(|r| r.3.is_some());
-    let mut out = MeshData::default();
-    let mut ids: PointIds = Vec::new();
-    let mut by_gid: std::collections::HashMap<u64, u32> = Default::default();
-    let mut by_key: std::collections::HashMap<[u64; 3], u32> = Default::default();
-    let key = |p: [f64; 3]| dist::point_key(glam::DVec3::from_array(p));
-    for (i, path, d, gids) in read {
-        let mut map = Vec::with_capacity(d.points.len());
-        for (v, &x) in d.points.iter().enumerate() {
-            let g = gids.as_ref().map(|g| g[v]);
-            let next = out.points.len() as u32;
-            let at = match (by_id, g) {
-                (true, Some(g)) => match by_gid.get(&g) {
-                    Some(&at) if out.points[at as usize] != x => {
-                        let other = pieces
-                            .iter()
-                            .find(|(j, _)| *j == ids[at as usize].1)
-                            .map_or_else(
-                                || "this piece".to_string(),
-                                |(_, p)| p.display().to_string(),
-                            );
-                        return Err(format!(
-                            "{}: GlobalPointIds {g} names {x:?} here and {:?} in {other}",
-                            path.display(),
-                            out.points[at as usize]
-                        ));
-                    }
-                    Some(&at) => at,
-                    None => {
-                        // Equal coordinates are one point even under two
-                        // ids: a point two ranks share without a shared
-                        // face (a pinch) gets an id from each.
-                        let at = *by_key.entry(key(x)).or_insert(next);
-                        by_gid.insert(g, at);
-                        at
-                    }
-                },
-                _ => *by_key.entry(key(x)).or_insert(next),
-            };
-            if at == next {
-                out.points.push(x);
-                ids.push((g, i));
-            }
-            map.push(at);
-        }
-        out.tets
-            .extend(d.tets.iter().map(|t| t.map(|v| map[v as usize])));
-        out.tet_regions
-            .extend((0..d.tets.len()).map(|t| d.region(t)));
-        out.triangles.extend(
-            d.triangles
-                .iter()
-                .map(|&(f, m)| (f.map(|v| map[v as usize]), m)),
-        );
-        out.edges.extend(
-            d.edges
-                .iter()
-                .map(|&(e, m)| (e.map(|v| map[v as usize]), m)),
-        );
-        out.corners
-            .extend(d.corners.iter().map(|&v| map[v as usize]));
-        out.required_vertices
-            .extend(d.required_vertices.iter().map(|&v| map[v as usize]));
-    }
-    out.corners.sort_unstable();
-    out.corners.dedup();
-    out.required_vertices.sort_unstable();
-    out.required_vertices.dedup();
-    Ok((out, ids))
 }
 
 /// Across ranks: every `GlobalPointIds` value names one point. Each

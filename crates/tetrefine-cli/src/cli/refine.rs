@@ -20,8 +20,9 @@ struct StatsFile<'a> {
 /// Arguments of `refine`.
 #[derive(clap::Args)]
 pub struct Args {
-    /// Input mesh. A `.pvtu` (distributed runs only, with a `.pvtu`
-    /// output) is read piece by piece, each rank its own pieces.
+    /// Input mesh. A `.pvtu`'s pieces are joined (shared points by
+    /// `GlobalPointIds`, else by coordinates); a distributed run with a
+    /// `.pvtu` output reads them per rank, each rank its own pieces.
     pub input: PathBuf,
     /// Output mesh (.vtu, .mesh, .msh, .node).
     #[arg(short, long)]
@@ -295,15 +296,6 @@ pub fn run(a: Args) -> super::CliResult {
         return Err(format!(
             "{}: a .pvtu is written by distributed runs: build with `--features mpi` and run under mpirun",
             a.output.display()
-        ));
-    }
-    if a.input
-        .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("pvtu"))
-    {
-        return Err(format!(
-            "{}: a .pvtu input is read piece by piece by distributed runs (feature `mpi`) into a .pvtu output: give -o OUT.pvtu",
-            a.input.display()
         ));
     }
     tetrefine::io::Format::for_writing(&a.output).map_err(|e| e.to_string())?;
