@@ -5,7 +5,10 @@ found, the tets are VTK tetrahedra with positive volumes (VTK's
 vtkCellSizeFilter) summing to the input's volume (the linear rule keeps the
 domain), the arrays region, quality, rank and GlobalPointIds are there, the
 ranks are 0 and 1, and the global ids number the points of the union
-densely (0 .. n-1, a point on the cut once).
+densely (0 .. n-1, a point on the cut once). When the pieces carry the
+vertex parent map (a run with --parent-map, --fields or --transfer), every
+point is its parent_bary combination of the parent_vertices of the input as
+VTK reads it.
 
 Usage: python3 tests/vtk_pvtu_reader.py X.pvtu INPUT.vtu     (needs `pip install vtk`)
 """
@@ -53,6 +56,16 @@ def main(pvtu, original):
     inp = vtk.vtkXMLUnstructuredGridReader()
     inp.SetFileName(original)
     inp.Update()
+    bary = grid.GetPointData().GetArray("parent_bary")
+    if bary is not None:
+        verts = vtk_to_numpy(grid.GetPointData().GetArray("parent_vertices"))
+        b = vtk_to_numpy(bary)
+        x_in = vtk_to_numpy(inp.GetOutput().GetPoints().GetData())
+        x = vtk_to_numpy(grid.GetPoints().GetData())
+        rebuilt = (b[:, :, None] * x_in[verts]).sum(axis=1)
+        err = abs(rebuilt - x).max()
+        assert err <= 1e-9 * max(1.0, abs(x).max()), err
+        print(f"{pvtu}: parent_bary rebuilds every point (max error {err:.2g})")
     v_in, v_out = volume(inp.GetOutput()), volume(grid)
     assert abs(v_in - v_out) <= 1e-9 * v_in, (v_in, v_out)
     print(f"{pvtu}: VTK {vtk.vtkVersion.GetVTKVersion()} reads {n} tets in 2 pieces, "

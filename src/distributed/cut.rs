@@ -81,7 +81,7 @@ pub fn across_faces(
 
 /// The rank that gathers key `k`: a fixed hash (FNV-1a over the bits), so
 /// the same on every rank and every run.
-fn home<const N: usize>(k: &[u64; N], size: u32) -> usize {
+pub(super) fn home<const N: usize>(k: &[u64; N], size: u32) -> usize {
     let mut h: u64 = 0xcbf2_9ce4_8422_2325;
     for &x in k {
         for b in x.to_le_bytes() {
@@ -94,7 +94,7 @@ fn home<const N: usize>(k: &[u64; N], size: u32) -> usize {
 
 /// Sends each key of `keys` to its home rank; there, the holders of every
 /// key (ranks in increasing order) by key.
-fn gather_at_home<const N: usize>(
+pub(super) fn gather_at_home<const N: usize>(
     comm: &Comm,
     keys: &[[u64; N]],
 ) -> Result<BTreeMap<[u64; N], Vec<u32>>, String> {
@@ -167,7 +167,7 @@ fn cut_keys(mesh: &TetMesh) -> CutKeys {
     }
 }
 
-fn flat(k: &FaceCoords) -> [u64; 9] {
+pub(super) fn flat(k: &FaceCoords) -> [u64; 9] {
     let mut out = [0u64; 9];
     for (i, p) in k.iter().enumerate() {
         out[3 * i..3 * i + 3].copy_from_slice(p);

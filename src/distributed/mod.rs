@@ -26,17 +26,23 @@
 //!    statistics of the union ([`global_stats`]) and, at the end, number
 //!    the points globally ([`global_point_ids`]).
 //!
+//! A `.pvtu` input skips step 1: each rank reads its own pieces and
+//! [`assemble`] finds the faces two ranks share, which become partition
+//! faces.
+//!
 //! Every collective is preceded by an agreement ([`Comm::agree`]): one
 //! rank's failure ends every rank with an error, never a hang.
 
+mod assemble;
 mod comm;
 mod cut;
 mod part;
 mod partition;
 
+pub use assemble::assemble;
 pub use comm::{failure_printed, Comm, OTHER_RANK_FAILED};
 pub use cut::{census, global_point_ids, global_stats, Census};
-pub use part::{MarkerSlots, Part};
+pub use part::{point_key, MarkerSlots, Part, PointKey, Reader, Wire};
 pub use partition::partition_dual_graph;
 
 use crate::mesh::partition::PartitionMarker;

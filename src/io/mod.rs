@@ -41,8 +41,9 @@ pub mod vtp {
     pub use crate::polyline::{write_cells, write_footer, write_header, write_points};
 }
 pub use vtk::{
-    read_noted as read_vtu_noted, read_tet_cell_array, write_pvtu, write_vtu, write_vtu_with,
-    CellArray, PointArray, TetCellArray, VtuSummary, DERIVED_CELL_ARRAYS, DERIVED_POINT_ARRAYS,
+    read_noted as read_vtu_noted, read_pvtu_pieces, read_tet_cell_array, write_pvtu, write_vtu,
+    write_vtu_with, CellArray, PointArray, TetCellArray, VtuSummary, DERIVED_CELL_ARRAYS,
+    DERIVED_POINT_ARRAYS,
 };
 
 pub(crate) use crate::file::open_message;

@@ -66,6 +66,12 @@ fn final_stats(path: &Path) -> serde_json::Value {
 /// The pieces a `.pvtu` lists, read and joined by their `GlobalPointIds`
 /// (equal ids must have equal coordinates), then built and checked.
 fn union_of_pieces(pvtu: &Path) -> (TetMesh, usize) {
+    let (mesh, owner) = union_with_owners(pvtu);
+    (mesh, owner.iter().max().map_or(0, |&m| m as usize + 1))
+}
+
+/// [`union_of_pieces`] with the piece each tet comes from.
+fn union_with_owners(pvtu: &Path) -> (TetMesh, Vec<u32>) {
     let text = std::fs::read_to_string(pvtu).unwrap();
     let sources: Vec<PathBuf> = text
         .lines()
@@ -75,7 +81,8 @@ fn union_of_pieces(pvtu: &Path) -> (TetMesh, usize) {
     assert!(!sources.is_empty(), "{text}");
     let mut data = MeshData::default();
     let mut by_gid: HashMap<i64, u32> = HashMap::new();
-    for s in &sources {
+    let mut owner = Vec::new();
+    for (piece, s) in sources.iter().enumerate() {
         let (d, meta) = tetrefine::io::read_mesh_with_meta(s).unwrap();
         let gids = meta
             .point_fields
@@ -100,11 +107,16 @@ fn union_of_pieces(pvtu: &Path) -> (TetMesh, usize) {
             .extend(d.tets.iter().map(|t| t.map(|v| map[v as usize])));
         data.tet_regions
             .extend((0..d.tets.len()).map(|i| d.region(i)));
+        owner.extend(std::iter::repeat_n(piece as u32, d.tets.len()));
     }
     let (mesh, report) = TetMesh::from_data(&data).expect("the union is a valid mesh");
     assert_eq!(report.reoriented, 0, "a piece held an inverted tet");
     mesh.check().expect("the union passes check()");
-    (mesh, sources.len())
+    assert_eq!(
+        owner.iter().max().map_or(0, |&m| m as usize + 1),
+        sources.len()
+    );
+    (mesh, owner)
 }
 
 /// Volume per region and boundary area.
@@ -587,22 +599,206 @@ fn a_gathered_output_carries_fields_and_the_parent_map() {
         }
         assert_eq!(n, mesh.n_points());
     }
-    // A .pvtu cannot carry them: refused by name, nothing written.
+}
+
+/// The `.vtu` files a `.pvtu` lists, in its order.
+fn piece_sources(pvtu: &Path) -> Vec<PathBuf> {
+    std::fs::read_to_string(pvtu)
+        .unwrap()
+        .lines()
+        .filter_map(|l| l.trim().strip_prefix("<Piece Source=\""))
+        .map(|l| pvtu.with_file_name(l.trim_end_matches("\"/>")))
+        .collect()
+}
+
+#[test]
+fn pieces_carry_fields_and_their_own_parent_maps() {
+    // Two ranks, a .pvtu output with a linear point field and a cell field
+    // from Medit solutions and --parent-map: every piece carries the field
+    // exactly at each of its points (linear interpolation reproduces a
+    // linear field), each tet the cell value of its parent, which holds the
+    // tet's centroid, and each piece's map (in its own numbering) gives
+    // every point as a barycentric combination of input points.
+    let dir = tempfile::tempdir().unwrap();
+    let tripod = input("meshes/tripod.mesh");
+    let pts: Vec<[f64; 3]> = tripod.points().iter().map(|p| p.to_array()).collect();
+    let fp = dir.path().join("f.sol");
+    let rows: Vec<Vec<f64>> = pts.iter().map(|&p| vec![field(p)]).collect();
+    support::write_sol(&fp, "SolAtVertices", &[1], &rows);
+    let cp = dir.path().join("cells.sol");
+    let rows: Vec<Vec<f64>> = (0..tripod.n_tets()).map(|t| vec![1.5 * t as f64]).collect();
+    support::write_sol(&cp, "SolAtTetrahedra", &[1], &rows);
     let out = dir.path().join("o.pvtu");
-    let o = mpirun(
+    let map = dir.path().join("map.txt");
+    let o = mpirun_ok(
         2,
         &[
             "refine",
             "meshes/tripod.mesh",
             "-o",
             out.to_str().unwrap(),
+            "--boundary",
+            "linear",
             "--fields",
             fp.to_str().unwrap(),
+            "--fields",
+            cp.to_str().unwrap(),
+            "--parent-map",
+            map.to_str().unwrap(),
         ],
     );
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("transfer: 1 point and 1 cell fields"), "{err}");
+    assert!(!map.exists(), "one map per piece, none for the whole");
+    let (union, _) = union_of_pieces(&out);
+    let pvtu = std::fs::read_to_string(&out).unwrap();
+    for name in ["f", "cells", "parent_tet", "parent_bary", "parent_vertices"] {
+        assert!(pvtu.contains(&format!("Name=\"{name}\"")), "{name}: {pvtu}");
+    }
+    // Whether input tet `t` holds `x` (a relative tolerance for round-off).
+    let holds = |t: u32, x: glam::DVec3| {
+        let p = tripod.tet_points(t);
+        let v = tet_volume(&p);
+        (0..4).all(|k| {
+            let mut q = p;
+            q[k] = x;
+            tet_volume(&q) >= -1e-9 * v
+        })
+    };
+    let sources = piece_sources(&out);
+    assert_eq!(sources.len(), 2);
+    let (mut tets, mut points) = (0, 0);
+    for (r, s) in sources.iter().enumerate() {
+        let (d, meta) = tetrefine::io::read_mesh_with_meta(s).unwrap();
+        let f = meta.point_fields.iter().find(|f| f.name == "f").unwrap();
+        for (i, p) in d.points.iter().enumerate() {
+            assert!(
+                (f.values[i] - field(*p)).abs() <= 1e-9,
+                "piece {r}, point {i}: {} vs {}",
+                f.values[i],
+                field(*p)
+            );
+        }
+        let parent = tetrefine::io::read_tet_cell_array(s, "parent")
+            .unwrap()
+            .values;
+        let cells = meta.cell_fields.iter().find(|f| f.name == "cells").unwrap();
+        assert_eq!(parent.len(), d.tets.len());
+        for (t, tet) in d.tets.iter().enumerate() {
+            assert_eq!(cells.values[t], 1.5 * parent[t], "piece {r}, tet {t}");
+            let c = tet
+                .iter()
+                .map(|&v| glam::DVec3::from_array(d.points[v as usize]))
+                .sum::<glam::DVec3>()
+                / 4.0;
+            assert!(holds(parent[t] as u32, c), "piece {r}, tet {t}");
+        }
+        // The piece's map, named like the piece: its tets' parents, then
+        // each point as its line's combination of input points.
+        let text = std::fs::read_to_string(dir.path().join(format!("map_{r}.txt"))).unwrap();
+        let (tet_lines, point_lines) = text.split_once("# points").expect("a points section");
+        let listed: Vec<f64> = tet_lines
+            .lines()
+            .filter(|l| !l.starts_with('#') && !l.trim().is_empty())
+            .map(|l| l.split_whitespace().nth(1).unwrap().parse().unwrap())
+            .collect();
+        assert_eq!(listed, parent, "piece {r}");
+        let mut n = 0;
+        for l in point_lines.lines().skip(1).filter(|l| !l.trim().is_empty()) {
+            let v: Vec<f64> = l.split_whitespace().map(|x| x.parse().unwrap()).collect();
+            assert_eq!(v[0] as usize, n, "piece {r}: 0-based, in order");
+            // (A point on the boundary may round to just outside the
+            // input: its nearest boundary point, within round-off.)
+            let corners = tripod.tet(v[1] as u32);
+            let mut x = [0.0; 3];
+            for k in 0..4 {
+                assert_eq!(v[2 + k] as u32, corners[k], "piece {r}, point {n}");
+                let q = pts[corners[k] as usize];
+                for a in 0..3 {
+                    x[a] += v[6 + k] * q[a];
+                }
+            }
+            for (xa, pa) in x.iter().zip(d.points[n]) {
+                assert!((xa - pa).abs() <= 1e-9, "piece {r}, point {n}");
+            }
+            n += 1;
+        }
+        assert_eq!(n, d.points.len(), "piece {r}");
+        tets += d.tets.len();
+        points += d.points.len();
+    }
+    assert_eq!(tets, union.n_tets());
+    assert!(
+        points > union.n_points(),
+        "the cut's points are in both pieces"
+    );
+
+    // That .pvtu as an input carries its fields on: read whole by the
+    // serial command and by rank 0 of a gathered run, the linear field is
+    // exact at every output point and each tet's cell value is that of its
+    // parent, numbered piece after piece.
+    let mut input_cells = Vec::new();
+    for s in &sources {
+        let (_, meta) = tetrefine::io::read_mesh_with_meta(s).unwrap();
+        let c = meta.cell_fields.iter().find(|f| f.name == "cells").unwrap();
+        input_cells.extend_from_slice(&c.values);
+    }
+    let serial = dir.path().join("serial.vtu");
+    serial_ok(&[
+        "refine",
+        out.to_str().unwrap(),
+        "-o",
+        serial.to_str().unwrap(),
+        "--boundary",
+        "linear",
+    ]);
+    let gathered = dir.path().join("gathered.vtu");
+    mpirun_ok(
+        2,
+        &[
+            "refine",
+            out.to_str().unwrap(),
+            "-o",
+            gathered.to_str().unwrap(),
+            "--boundary",
+            "linear",
+        ],
+    );
+    for file in [&serial, &gathered] {
+        let (d, meta) = tetrefine::io::read_mesh_with_meta(file).unwrap();
+        let f = meta.point_fields.iter().find(|f| f.name == "f").unwrap();
+        for (i, p) in d.points.iter().enumerate() {
+            assert!(
+                (f.values[i] - field(*p)).abs() <= 1e-9,
+                "{file:?}, point {i}"
+            );
+        }
+        let parent = tetrefine::io::read_tet_cell_array(file, "parent")
+            .unwrap()
+            .values;
+        let cells = meta.cell_fields.iter().find(|f| f.name == "cells").unwrap();
+        for (t, &p) in parent.iter().enumerate() {
+            assert_eq!(
+                cells.values[t], input_cells[p as usize],
+                "{file:?}, tet {t}"
+            );
+        }
+    }
+    // Read per rank into pieces, the fields cannot follow: refused with
+    // the way out, which then works.
+    let again = dir.path().join("again.pvtu");
+    let args = [
+        "refine",
+        out.to_str().unwrap(),
+        "-o",
+        again.to_str().unwrap(),
+    ];
+    let o = mpirun(2, &args);
     assert!(!o.status.success());
-    assert!(String::from_utf8_lossy(&o.stderr).contains("--fields"));
-    assert!(!out.exists());
+    assert!(String::from_utf8_lossy(&o.stderr).contains("--no-transfer"));
+    assert!(!again.exists());
+    mpirun_ok(2, &[&args[..], &["--no-transfer"]].concat());
+    assert_eq!(piece_sources(&again).len(), 2);
 }
 
 /// Area of the marked faces (boundary and interior), per marker.
@@ -715,4 +911,227 @@ fn a_rank_that_dies_ends_the_job_without_a_hang_or_output() {
     assert!(!o.status.success());
     let left: Vec<_> = std::fs::read_dir(dir.path()).unwrap().collect();
     assert!(left.is_empty(), "{left:?}");
+}
+
+/// The serial step on the union of `pvtu`'s pieces with the faces between
+/// pieces marked as partition faces (features detected on the union, as a
+/// single-file input's are): the count the ranks reading those pieces must
+/// reach together.
+fn serial_on_pieces_with_their_cut(pvtu: &Path, step_offset: usize) -> usize {
+    let (mut mesh, owner) = union_with_owners(pvtu);
+    tetrefine::detect_features_for(&mut mesh, 45.0, tetrefine::InterfaceRule::Linear);
+    let mut cut = 0;
+    for t in 0..mesh.n_tets() as u32 {
+        for f in 0..4 {
+            let h = mesh.adj(t)[f];
+            if h != NO_ADJ && owner[t as usize] != owner[(h >> 2) as usize] {
+                mesh.set_face_marker(
+                    mesh.face_vertices(t, f),
+                    Some(partition_marker(owner[(h >> 2) as usize])),
+                );
+                cut += 1;
+            }
+        }
+    }
+    assert!(cut > 0);
+    let opts = RefineOptions {
+        boundary: Sqrt3Rule::Linear,
+        opt_passes: 0,
+        step_offset,
+        ..RefineOptions::default()
+    };
+    tetrefine::refine(&mut mesh, 1, &opts);
+    mesh.n_tets()
+}
+
+#[test]
+fn pvtu_pieces_read_per_rank_step_as_the_serial_mesh_with_their_cut_marked() {
+    // The pieces METIS made, unrefined (no step, no cut move), read back
+    // by two ranks: the step (linear, no optimisation, an even global
+    // step: feature edges trisected) gives the serial step's count on the
+    // union of the pieces with the faces between them marked.
+    let dir = tempfile::tempdir().unwrap();
+    let s = |p: &Path| p.to_str().unwrap().to_string();
+    let a = dir.path().join("a.pvtu");
+    mpirun_ok(
+        2,
+        &[
+            "refine",
+            "meshes/tripod.mesh",
+            "-o",
+            &s(&a),
+            "--steps",
+            "0",
+            "--allow-steps-zero",
+            "--stop-after",
+            "optimize",
+        ],
+    );
+    let b = dir.path().join("b.pvtu");
+    let stats = dir.path().join("b.json");
+    mpirun_ok(
+        2,
+        &[
+            "refine",
+            &s(&a),
+            "-o",
+            &s(&b),
+            "--boundary",
+            "linear",
+            "--opt-passes",
+            "0",
+            "--step-offset",
+            "1",
+            "--stats",
+            &s(&stats),
+        ],
+    );
+    let got = final_stats(&stats)["tets"].as_u64().unwrap() as usize;
+    assert_eq!(got, serial_on_pieces_with_their_cut(&a, 1));
+    let (union, _) = union_of_pieces(&b);
+    assert_eq!(union.n_tets(), got);
+}
+
+#[test]
+fn a_pvtu_written_on_2_ranks_is_read_back_per_rank_and_refined_again() {
+    // Refine once to a .pvtu on two ranks, then refine that .pvtu again on
+    // two ranks (each reads its piece) and on one (it reads both): one
+    // conforming mesh with the input's exact region volumes and boundary
+    // area (linear rule), and the reported count.
+    let dir = tempfile::tempdir().unwrap();
+    let s = |p: &Path| p.to_str().unwrap().to_string();
+    for name in ["meshes/tripod.mesh", "meshes/gmsh_t16.mesh"] {
+        let (vol_in, area_in) = measures(&input(name));
+        let a = dir.path().join("a.pvtu");
+        mpirun_ok(2, &["refine", name, "-o", &s(&a), "--boundary", "linear"]);
+        for ranks in [2, 1] {
+            let b = dir.path().join(format!("b{ranks}.pvtu"));
+            let stats = dir.path().join("b.json");
+            let o = mpirun_ok(
+                ranks,
+                &[
+                    "refine",
+                    &s(&a),
+                    "-o",
+                    &s(&b),
+                    "--boundary",
+                    "linear",
+                    "--step-offset",
+                    "1",
+                    "--stats",
+                    &s(&stats),
+                ],
+            );
+            let err = String::from_utf8_lossy(&o.stderr);
+            assert!(
+                err.contains(&format!("2 pieces read on {ranks} ranks")),
+                "{err}"
+            );
+            let (union, pieces) = union_of_pieces(&b);
+            assert_eq!(pieces, ranks as usize);
+            let (vol, area) = measures(&union);
+            assert_eq!(
+                vol.keys().collect::<Vec<_>>(),
+                vol_in.keys().collect::<Vec<_>>()
+            );
+            for (r, v) in &vol {
+                assert!(
+                    close(*v, vol_in[r], 1e-9),
+                    "{name} -n {ranks}: region {r}: {v} vs {}",
+                    vol_in[r]
+                );
+            }
+            assert!(
+                close(area, area_in, 1e-9),
+                "{name}: area {area} vs {area_in}"
+            );
+            let d = final_stats(&stats);
+            assert_eq!(d["tets"].as_u64().unwrap() as usize, union.n_tets());
+            assert_eq!(d["nodes"].as_u64().unwrap() as usize, union.n_points());
+            assert_eq!(d["inverted"].as_u64(), Some(0));
+        }
+    }
+}
+
+#[test]
+fn a_bad_pvtu_piece_ends_every_rank_naming_the_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let s = |p: &Path| p.to_str().unwrap().to_string();
+    let a = dir.path().join("a.pvtu");
+    mpirun_ok(
+        2,
+        &[
+            "refine",
+            "meshes/tripod.mesh",
+            "-o",
+            &s(&a),
+            "--boundary",
+            "linear",
+        ],
+    );
+    let pieces = piece_sources(&a);
+    let out = dir.path().join("o.pvtu");
+    let fails = |ranks: u32, what: &str, expect: &[&str]| {
+        let o = Command::new("timeout")
+            .args([
+                "300",
+                "mpirun",
+                "--allow-run-as-root",
+                "--oversubscribe",
+                "-n",
+            ])
+            .arg(ranks.to_string())
+            .arg(env!("CARGO_BIN_EXE_tetrefine"))
+            .args(["refine", &s(&a), "-o", &s(&out)])
+            .current_dir(support::root())
+            .output()
+            .unwrap();
+        assert_ne!(o.status.code(), Some(124), "{what}: the job hung");
+        assert!(!o.status.success(), "{what}");
+        let err = String::from_utf8_lossy(&o.stderr);
+        for e in expect {
+            assert!(err.contains(e), "{what}: {err}");
+        }
+        assert!(!out.exists(), "{what}");
+        assert!(!piece_sources_exist(&out), "{what}");
+    };
+    // Fewer pieces than ranks.
+    fails(3, "3 ranks", &["a.pvtu", "2 pieces for 3 ranks"]);
+    // GlobalPointIds that disagree between the pieces: piece 1's shifted
+    // by one, so an id names another point than in piece 0.
+    let good = std::fs::read(&pieces[1]).unwrap();
+    let (m, _) = tetrefine::io::load_mesh(&pieces[1]).unwrap();
+    let (_, meta) = tetrefine::io::read_mesh_with_meta(&pieces[1]).unwrap();
+    let gids = &meta
+        .point_fields
+        .iter()
+        .find(|f| f.name == "GlobalPointIds")
+        .unwrap()
+        .values;
+    let shifted: Vec<i32> = gids.iter().map(|&g| g as i32 + 1).collect();
+    tetrefine::io::write_vtu_with(
+        &pieces[1],
+        &m,
+        None,
+        &[],
+        &[tetrefine::io::PointArray::Int32(
+            "GlobalPointIds".into(),
+            1,
+            shifted,
+        )],
+    )
+    .unwrap();
+    fails(2, "shifted ids", &["GlobalPointIds", "a_"]);
+    fails(1, "shifted ids, one rank", &["a_1.vtu", "GlobalPointIds"]);
+    // A truncated piece, then a missing one.
+    std::fs::write(&pieces[1], &good[..good.len() / 2]).unwrap();
+    fails(2, "truncated", &["a_1.vtu"]);
+    std::fs::remove_file(&pieces[1]).unwrap();
+    fails(2, "missing", &["a_1.vtu"]);
+}
+
+/// Whether any piece `OUT_r.vtu` of `out` exists.
+fn piece_sources_exist(out: &Path) -> bool {
+    let stem = out.file_stem().unwrap().to_string_lossy().into_owned();
+    (0..4).any(|r| out.with_file_name(format!("{stem}_{r}.vtu")).exists())
 }

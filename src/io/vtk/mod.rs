@@ -29,10 +29,12 @@
 //! say) at the tetrahedra of a file, in the order [`read`] lists them.
 
 mod decode;
+mod pvtu;
 mod read;
 mod write;
 mod xml;
 
+pub use pvtu::read_pvtu_pieces;
 pub use read::{
     read_noted, read_tet_cell_array, read_with_meta_noted, TetCellArray, DERIVED_CELL_ARRAYS,
     DERIVED_POINT_ARRAYS,

@@ -3,10 +3,15 @@
 //! improvement, and the result is written as one `.vtu` piece per rank plus
 //! a `.pvtu` (an `-o *.pvtu`), or gathered into one file of any format,
 //! which rank 0 writes as the serial command does (point locations in the
-//! input it kept, `--parent-map`, `--fields`/`--transfer`, `marked`).
+//! input it kept, `--parent-map`, `--fields`/`--transfer`, `marked`). With
+//! pieces, `--parent-map` and the fields come from rank 0 too, one piece at
+//! a time ([`super::piece_fields`]); each rank writes its own.
+//! A `.pvtu` input with a `.pvtu` output is read per rank instead
+//! ([`super::pvtu_input`]).
 //! Rank 0 prints the step table of the whole mesh; every file appears only
 //! when every rank succeeded.
 
+use super::piece_fields::{locate_pieces, Input, Located};
 use super::progress::BarProgress;
 use super::refine::{mark_strategy, selection_of, Args, SmoothScope};
 use super::steps::{peak_rss_bytes, StepStats};
@@ -50,9 +55,7 @@ struct StatsFile<'a> {
     seconds: f64,
 }
 
-/// Options of the serial command that have no distributed meaning yet, and
-/// those a `.pvtu` output cannot carry (a gathered output writes them as the
-/// serial command does, on rank 0).
+/// Options of the serial command that have no distributed meaning yet.
 fn refuse_serial_only(a: &Args) -> super::CliResult {
     let refused = [
         ("--size", a.size.is_some()),
@@ -65,23 +68,14 @@ fn refuse_serial_only(a: &Args) -> super::CliResult {
             "{name} is not available in a distributed run (mpirun or a .pvtu output); run it serially"
         ));
     }
-    let gathered_only = [
-        ("--parent-map", a.parent_map.is_some()),
-        ("--fields", !a.fields.is_empty()),
-        ("--transfer", a.transfer),
-    ];
-    match gathered_only.iter().find(|(_, on)| *on) {
-        Some((name, _)) if is_pvtu(&a.output) => Err(format!(
-            "{name} is not available with a .pvtu output (each piece would need the whole input); give -o a single file (e.g. out.vtu), which rank 0 writes gathered with the fields and the parent map"
-        )),
-        _ => Ok(()),
-    }
+    Ok(())
 }
 
 /// Runs `refine` distributed.
 pub fn run(a: Args) -> super::CliResult {
     refuse_serial_only(&a)?;
     let pieces = is_pvtu(&a.output);
+    let pvtu_in = super::pvtu_input::per_rank(&a);
     if !pieces {
         tetrefine::io::Format::for_writing(&a.output).map_err(|e| e.to_string())?;
     }
@@ -107,33 +101,49 @@ pub fn run(a: Args) -> super::CliResult {
     let (_universe, comm) = dist::init()?;
     let t0 = Instant::now();
     let root = comm.rank == 0;
-    // Rank 0 reads; its failure (a bad file) ends every rank.
-    let loaded = if root {
-        load_on_root(&a, strategy.as_ref())
-    } else {
-        Ok(None)
-    };
-    let loaded = comm.agree(loaded)?;
-    let (mut input, meta, selection, transfer) = match loaded {
-        Some((m, meta, s, t)) => (Some(m), meta, s, t),
-        None => (None, Default::default(), None, false),
-    };
     let mut steps = Vec::new();
-    if let Some(m) = &input {
-        let first = MeshStats::compute(m);
-        crate::say!("{}", step_table_header());
-        crate::say!("{}", step_row("input", &first, 0.0));
-        steps.push(StepStats::input(first));
-        eprintln!(
-            "distributing {} tets over {} ranks (METIS)",
-            m.n_tets(),
-            comm.size
-        );
-    }
-    let (mut local, first_selection) =
-        dist::distribute(&comm, input.as_ref(), selection.as_deref(), n_steps)?;
-    if pieces {
-        // A gathered output locates its points in the input on rank 0.
+    let (mut input, meta, selection, transfer, mut local, first_selection) = if pvtu_in {
+        // Every rank reads its own pieces; nobody holds the whole input.
+        let local = super::pvtu_input::load_pieces(&comm, &a)?;
+        let c = dist::census(&comm, &local.mesh)?;
+        let first = dist::global_stats(&comm, &local.mesh, &c)?;
+        if root {
+            crate::say!("{}", step_table_header());
+            crate::say!("{}", step_row("input", &first, 0.0));
+            steps.push(StepStats::input(first));
+        }
+        (None, Default::default(), None, false, local, None)
+    } else {
+        // Rank 0 reads; its failure (a bad file) ends every rank.
+        let loaded = if root {
+            load_on_root(&a, strategy.as_ref())
+        } else {
+            Ok(None)
+        };
+        let loaded = comm.agree(loaded)?;
+        let (input, meta, selection, transfer) = match loaded {
+            Some((m, meta, s, t)) => (Some(m), meta, s, t),
+            None => (None, Default::default(), None, false),
+        };
+        if let Some(m) = &input {
+            let first = MeshStats::compute(m);
+            crate::say!("{}", step_table_header());
+            crate::say!("{}", step_row("input", &first, 0.0));
+            steps.push(StepStats::input(first));
+            eprintln!(
+                "distributing {} tets over {} ranks (METIS)",
+                m.n_tets(),
+                comm.size
+            );
+        }
+        let (local, first_selection) =
+            dist::distribute(&comm, input.as_ref(), selection.as_deref(), n_steps)?;
+        (input, meta, selection, transfer, local, first_selection)
+    };
+    // Pieces are located in the input (on rank 0) only for the parent map
+    // and the fields; a gathered output always is, as the serial one.
+    let locate = a.parent_map.is_some() || comm.sum(&[u64::from(transfer)])[0] > 0;
+    if pieces && !locate {
         input = None;
     }
     let opts = DistributedOptions {
@@ -208,7 +218,24 @@ pub fn run(a: Args) -> super::CliResult {
         None
     };
     let written = if pieces {
-        write_pieces(&comm, &a.output, &mut local, &last)
+        let located = if locate {
+            let at = input.as_ref().map(|mesh| Input {
+                mesh,
+                meta: &meta,
+                transfer,
+            });
+            Some(locate_pieces(&comm, at.as_ref(), &mut local.mesh)?)
+        } else {
+            None
+        };
+        write_pieces(
+            &comm,
+            &a.output,
+            a.parent_map.as_deref(),
+            &mut local,
+            located,
+            &last,
+        )
     } else {
         match (union.as_mut(), &input) {
             (Some(mesh), Some(input)) => {
@@ -271,12 +298,39 @@ fn piece_path(pvtu: &Path, rank: u32) -> PathBuf {
     pvtu.with_file_name(format!("{stem}_{rank}.vtu"))
 }
 
+/// `MAP_r.EXT` beside `MAP.EXT` (`MAP_r` without an extension): rank `r`'s
+/// `--parent-map` with a `.pvtu` output.
+pub fn piece_map_path(map: &Path, rank: u32) -> PathBuf {
+    let stem = map
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    match map.extension() {
+        Some(e) => map.with_file_name(format!("{stem}_{rank}.{}", e.to_string_lossy())),
+        None => map.with_file_name(format!("{stem}_{rank}")),
+    }
+}
+
+/// A field name the pieces' own arrays (`GlobalPointIds`, `rank`) use gets
+/// `_input` appended, as [`super::transfer::vtu_arrays`] does for the
+/// serial arrays.
+fn rename_clashes(fields: &mut [tetrefine::io::Field], taken: &str) {
+    for f in fields.iter_mut().filter(|f| f.name == taken) {
+        f.name = format!("{taken}_input");
+    }
+}
+
 /// One `.vtu` per rank (with `GlobalPointIds`, `rank`, `level`, `parent`
-/// and the quality arrays) and, on rank 0, the `.pvtu` listing them.
+/// and the quality arrays; with `located`, the vertex parent map's arrays
+/// and the input's fields, and `parent` is the input tet holding each
+/// centroid), `MAP_r` for `--parent-map MAP`, and on rank 0 the `.pvtu`
+/// listing the pieces with the same arrays.
 fn write_pieces(
     comm: &Comm,
     pvtu: &Path,
+    parent_map: Option<&Path>,
     local: &mut LocalMesh,
+    located: Option<Located>,
     global: &MeshStats,
 ) -> Result<(), String> {
     let ids = dist::global_point_ids(comm, &local.mesh)?;
@@ -291,12 +345,33 @@ fn write_pieces(
     let level = |i: usize| i32::from(mesh.level(i as u32));
     let parent = |i: usize| mesh.parent(i as u32) as i32;
     let rank_of = |_: usize| rank;
-    let cells = vec![
+    let mut cells = vec![
         CellArray::Int32With("level".into(), n, &level),
         CellArray::Int32With("parent".into(), n, &parent),
         CellArray::Int32With("rank".into(), n, &rank_of),
     ];
-    let points = vec![PointArray::Int32("GlobalPointIds".into(), 1, gids)];
+    let mut points = vec![PointArray::Int32("GlobalPointIds".into(), 1, gids)];
+    if let Some(mut l) = located {
+        if let Some(map) = parent_map {
+            let vertices = |i: usize| l.vertices[i];
+            super::transfer::write_parent_map(
+                &piece_map_path(map, comm.rank),
+                &vertices,
+                mesh,
+                &l.locations,
+            )?;
+        }
+        rename_clashes(&mut l.point_fields, "GlobalPointIds");
+        rename_clashes(&mut l.cell_fields, "rank");
+        let (p, c) = super::transfer::vtu_arrays(
+            &|i| l.vertices[i],
+            Some(&l.locations),
+            &l.point_fields,
+            &l.cell_fields,
+        );
+        points.extend(p);
+        cells.extend(c);
+    }
     let valence = MeshStats::vertex_valence(mesh);
     let summary = VtuSummary {
         valence: &valence,

@@ -9,7 +9,12 @@ pub mod guard;
 pub mod improve;
 pub mod mesh;
 pub mod outputs;
+#[cfg(feature = "mpi")]
+pub mod piece_fields;
 pub mod progress;
+#[cfg(feature = "mpi")]
+pub mod pvtu_input;
+pub mod pvtu_merge;
 pub mod quality;
 pub mod refine;
 pub mod size;
@@ -45,8 +50,18 @@ pub fn load(path: &std::path::Path) -> Result<tetrefine::TetMesh, String> {
 pub fn load_with_meta(
     path: &std::path::Path,
 ) -> Result<(tetrefine::TetMesh, tetrefine::io::MeshMeta), String> {
-    let (mesh, report, meta, notes) =
-        tetrefine::io::load_mesh_with_meta_noted(path).map_err(|e| e.to_string())?;
+    let is_pvtu = path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("pvtu"));
+    let (mesh, report, meta, notes) = if is_pvtu {
+        // Every piece, joined (see `pvtu_merge`).
+        let (data, meta) = pvtu_merge::read_pvtu(path)?;
+        let (mesh, report) =
+            tetrefine::TetMesh::from_data(&data).map_err(|e| format!("{}: {e}", path.display()))?;
+        (mesh, report, meta, Vec::new())
+    } else {
+        tetrefine::io::load_mesh_with_meta_noted(path).map_err(|e| e.to_string())?
+    };
     for n in notes {
         eprintln!("note: {}: {n}", path.display());
     }

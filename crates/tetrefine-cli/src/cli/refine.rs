@@ -20,7 +20,9 @@ struct StatsFile<'a> {
 /// Arguments of `refine`.
 #[derive(clap::Args)]
 pub struct Args {
-    /// Input mesh.
+    /// Input mesh. A `.pvtu`'s pieces are joined (shared points by
+    /// `GlobalPointIds`, else by coordinates); a distributed run with a
+    /// `.pvtu` output reads them per rank, each rank its own pieces.
     pub input: PathBuf,
     /// Output mesh (.vtu, .mesh, .msh, .node).
     #[arg(short, long)]
@@ -123,7 +125,10 @@ pub struct Args {
     /// then, after a `# points` line, the vertex parent map: per output
     /// point `new_point input_tet v0 v1 v2 v3 b0 b1 b2 b3 outside` (the
     /// input tet holding it, its vertices and the point's barycentric
-    /// coordinates), so a solver can carry its fields over.
+    /// coordinates), so a solver can carry its fields over. With a `.pvtu`
+    /// output (a distributed run) one file per piece, named like the
+    /// pieces: `MAP_r.EXT` beside `MAP.EXT`, in piece `r`'s own 0-based
+    /// numbering (input ids stay global).
     #[arg(long)]
     pub parent_map: Option<PathBuf>,
     /// Carry the input's fields over (the default when it has any: `.vtu`
@@ -596,7 +601,7 @@ pub(super) fn write_output(
     let locations = (transfer || is_vtu || a.parent_map.is_some())
         .then(|| tetrefine::locate_points(input, mesh));
     if let (Some(path), Some(locs)) = (&a.parent_map, &locations) {
-        super::transfer::write_parent_map(path, input, mesh, locs)?;
+        super::transfer::write_parent_map(path, &|i| input.tet(locs[i].tet), mesh, locs)?;
     }
     // Whether the tet descends from a selected input tet (all do without a
     // selection).
@@ -615,7 +620,13 @@ pub(super) fn write_output(
         _ => (Vec::new(), Vec::new()),
     };
     let arrays = if is_vtu {
-        super::transfer::vtu_arrays(input, locations.as_deref(), &point_fields, &cell_fields)
+        let locs = locations.as_deref().unwrap_or(&[]);
+        super::transfer::vtu_arrays(
+            &|i| input.tet(locs[i].tet),
+            locations.as_deref(),
+            &point_fields,
+            &cell_fields,
+        )
     } else {
         (Vec::new(), Vec::new())
     };

@@ -50,9 +50,10 @@ fn vtu_name(name: &str, taken: &[&str]) -> String {
 
 /// The `.vtu` point and cell arrays: the vertex parent map (`parent_tet`,
 /// `parent_vertices`, `parent_bary`, `parent_outside`) when `locations` are
-/// given, and the transferred fields.
+/// given (`vertices(i)`: the input vertices of location `i`'s tet), and the
+/// transferred fields.
 pub fn vtu_arrays(
-    input: &TetMesh,
+    vertices: &dyn Fn(usize) -> [u32; 4],
     locations: Option<&[PointParent]>,
     point_fields: &[Field],
     cell_fields: &[Field],
@@ -67,8 +68,8 @@ pub fn vtu_arrays(
         points.push(PointArray::Int32(
             "parent_vertices".into(),
             4,
-            locs.iter()
-                .flat_map(|l| input.tet(l.tet).map(|v| v as i32))
+            (0..locs.len())
+                .flat_map(|i| vertices(i).map(|v| v as i32))
                 .collect(),
         ));
         points.push(PointArray::Float64(
@@ -103,11 +104,11 @@ pub fn vtu_arrays(
 }
 
 /// Writes the `--parent-map` file: per output tet its parent, then per
-/// output point its input tet, that tet's vertices and the barycentric
-/// coordinates (all ids 0-based).
+/// output point its input tet, that tet's vertices (`vertices(i)` for
+/// location `i`) and the barycentric coordinates (all ids 0-based).
 pub fn write_parent_map(
     path: &Path,
-    input: &TetMesh,
+    vertices: &dyn Fn(usize) -> [u32; 4],
     mesh: &TetMesh,
     locations: &[PointParent],
 ) -> super::CliResult {
@@ -126,7 +127,7 @@ pub fn write_parent_map(
             "# points: new_point input_tet v0 v1 v2 v3 b0 b1 b2 b3 outside (0-based; v = the input tet's vertices, b = the point's barycentric coordinates for them; outside = 1: the point lies outside the input domain and b give the nearest input boundary point)"
         )?;
         for (i, l) in locations.iter().enumerate() {
-            let v = input.tet(l.tet);
+            let v = vertices(i);
             writeln!(
                 w,
                 "{i} {} {} {} {} {} {:?} {:?} {:?} {:?} {}",
