@@ -146,6 +146,30 @@ pub fn run(a: Args) -> super::CliResult {
     if pieces && !locate {
         input = None;
     }
+    // The steps the input has had (see `refine::step_offset`): from the
+    // pieces each rank read, or from the file rank 0 read; said once.
+    let step_offset = match a.step_offset {
+        Some(k) => k,
+        None => {
+            let own = if pvtu_in {
+                let all = tetrefine::io::read_pvtu_pieces(&a.input).unwrap_or_default();
+                super::pvtu_input::own_pieces(&comm, &all)
+                    .into_iter()
+                    .map(|(_, p)| super::refine::steps_done(p))
+                    .max()
+                    .unwrap_or(0)
+            } else if comm.rank == 0 && super::refine::is_vtu_or_pvtu(&a.input) {
+                super::refine::steps_done(&a.input)
+            } else {
+                0
+            };
+            let steps = comm.all_gather(own as u64).into_iter().max().unwrap_or(0) as usize;
+            if comm.rank == 0 {
+                super::refine::note_steps_done(&a.input, steps);
+            }
+            steps
+        }
+    };
     let opts = DistributedOptions {
         refine: RefineOptions {
             boundary: a.boundary,
@@ -154,7 +178,7 @@ pub fn run(a: Args) -> super::CliResult {
             stop_after: a.stop_after,
             selection: None,
             smooth_refined_only: first_selection.is_some() && a.smooth == SmoothScope::Refined,
-            step_offset: super::refine::step_offset(&a),
+            step_offset,
             check_each_phase: false,
             effort: a.effort,
             hausd: a.hausd,

@@ -45,13 +45,7 @@ pub fn load_pieces(comm: &Comm, a: &Args) -> Result<LocalMesh, String> {
     } else {
         Ok(())
     })?;
-    let r = u64::from(comm.rank);
-    let mine: Vec<(usize, &PathBuf)> = all
-        .iter()
-        .enumerate()
-        .skip((r * k / p) as usize)
-        .take(((r + 1) * k / p - r * k / p) as usize)
-        .collect();
+    let mine = own_pieces(comm, &all);
     let read = super::pvtu_merge::merge_pieces(&mine);
     let (data, ids, fields) = comm.agree(read)?;
     // A rank holds its own pieces only: it could not interpolate their
@@ -104,6 +98,18 @@ pub fn load_pieces(comm: &Comm, a: &Args) -> Result<LocalMesh, String> {
         );
     }
     dist::assemble(comm, mesh, first as u32)
+}
+
+/// The pieces (index, path) rank `comm.rank` reads of `all`: a contiguous
+/// block, ⌊rK/P⌋ to ⌊(r+1)K/P⌋ − 1 (none when there are fewer pieces than
+/// ranks and this rank's block is empty).
+pub fn own_pieces<'a>(comm: &Comm, all: &'a [PathBuf]) -> Vec<(usize, &'a PathBuf)> {
+    let (k, p, r) = (all.len() as u64, u64::from(comm.size), u64::from(comm.rank));
+    all.iter()
+        .enumerate()
+        .skip((r * k / p) as usize)
+        .take(((r + 1) * k / p - r * k / p) as usize)
+        .collect()
 }
 
 /// Across ranks: every `GlobalPointIds` value names one point. Each

@@ -506,34 +506,49 @@ pub(super) fn step_offset(a: &Args) -> usize {
     if let Some(k) = a.step_offset {
         return k;
     }
-    let is_vtu = a
-        .input
-        .extension()
+    let steps = if is_vtu_or_pvtu(&a.input) {
+        steps_done(&a.input)
+    } else {
+        0
+    };
+    note_steps_done(&a.input, steps);
+    steps
+}
+
+/// Whether `p` names a `.vtu` or a `.pvtu`.
+pub(super) fn is_vtu_or_pvtu(p: &std::path::Path) -> bool {
+    p.extension()
         .and_then(|e| e.to_str())
-        .is_some_and(|e| e.eq_ignore_ascii_case("vtu") || e.eq_ignore_ascii_case("pvtu"));
-    if !is_vtu {
-        return 0;
-    }
-    let Ok(level) = tetrefine::io::read_tet_cell_array(&a.input, "level") else {
+        .is_some_and(|e| e.eq_ignore_ascii_case("vtu") || e.eq_ignore_ascii_case("pvtu"))
+}
+
+/// The largest value of the `level` cell array of the `.vtu` (or every
+/// piece of the `.pvtu`) at `path`: the steps tetrefine has made on it. 0
+/// without such an array or with one that is not whole numbers in 0–255.
+pub(super) fn steps_done(path: &std::path::Path) -> usize {
+    let Ok(level) = tetrefine::io::read_tet_cell_array(path, "level") else {
         return 0;
     };
     let usable = level
         .values
         .iter()
         .all(|&l| l.is_finite() && l >= 0.0 && l.fract() == 0.0 && l <= 255.0);
-    let steps = if usable {
+    if usable {
         level.values.iter().fold(0.0f64, |m, &l| m.max(l)) as usize
     } else {
         0
-    };
+    }
+}
+
+/// Says that the step count goes on from `steps` (when there are any).
+pub(super) fn note_steps_done(input: &std::path::Path, steps: usize) {
     if steps > 0 {
         eprintln!(
             "note: {} has had {steps} refinement step{} (its `level` array): the steps go on from there (--step-offset 0 starts the count over)",
-            a.input.display(),
+            input.display(),
             if steps == 1 { "" } else { "s" }
         );
     }
-    steps
 }
 
 /// Adds `--fields` to the input's `meta`, checks `--transfer` against what
