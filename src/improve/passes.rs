@@ -78,7 +78,7 @@ pub struct ImproveOptions {
     pub insert_vertices: bool,
     /// The quality (min sine) the passes should leave every tet at or
     /// above: while a tet that may change is below it, passes go on past
-    /// `passes`, at most [`FLOOR_PASSES`] more, as long as each raises the
+    /// `passes`, at most four more, as long as each raises the
     /// worst of them and changes something. A refinement step sets it from
     /// its input's worst tet (so that a refined mesh is not worse than its
     /// input); 0: none.
@@ -87,7 +87,7 @@ pub struct ImproveOptions {
 
 /// Passes [`improve`] runs at most past [`ImproveOptions::passes`] while a
 /// tet is below [`ImproveOptions::floor`].
-pub const FLOOR_PASSES: usize = 4;
+const FLOOR_PASSES: usize = 4;
 
 impl Default for ImproveOptions {
     fn default() -> Self {
