@@ -141,6 +141,28 @@ fn input(name: &str) -> TetMesh {
         .0
 }
 
+/// `mesh` has the regions of `vol_in`, each with its volume, and the
+/// boundary area `area_in` (an unmatched cut face would be extra boundary).
+fn assert_measures_kept(what: &str, mesh: &TetMesh, vol_in: &BTreeMap<i32, f64>, area_in: f64) {
+    let (vol, area) = measures(mesh);
+    assert_eq!(
+        vol.keys().collect::<Vec<_>>(),
+        vol_in.keys().collect::<Vec<_>>(),
+        "{what}"
+    );
+    for (r, v) in &vol {
+        assert!(
+            close(*v, vol_in[r], 1e-9),
+            "{what}: region {r}: {v} vs {}",
+            vol_in[r]
+        );
+    }
+    assert!(
+        close(area, area_in, 1e-9),
+        "{what}: boundary area {area} vs {area_in}"
+    );
+}
+
 fn close(a: f64, b: f64, rel: f64) -> bool {
     (a - b).abs() <= rel * a.abs().max(b.abs())
 }
@@ -184,23 +206,7 @@ fn pieces_form_one_conforming_mesh_with_exact_region_volumes_on_1_and_2_ranks() 
             );
             let (union, pieces) = union_of_pieces(&out);
             assert_eq!(pieces, ranks as usize);
-            let (vol, area) = measures(&union);
-            assert_eq!(
-                vol.keys().collect::<Vec<_>>(),
-                vol_in.keys().collect::<Vec<_>>()
-            );
-            for (r, v) in &vol {
-                assert!(
-                    close(*v, vol_in[r], 1e-9),
-                    "{name} -n {ranks}: region {r}: {v} vs {}",
-                    vol_in[r]
-                );
-            }
-            // An unmatched cut face would be extra boundary.
-            assert!(
-                close(area, area_in, 1e-9),
-                "{name} -n {ranks}: boundary area {area} vs {area_in}"
-            );
+            assert_measures_kept(&format!("{name} -n {ranks}"), &union, &vol_in, area_in);
             let d = final_stats(&stats);
             assert_eq!(
                 d["tets"].as_u64().unwrap() as usize,
@@ -514,17 +520,29 @@ fn field(p: [f64; 3]) -> f64 {
     2.0 + 0.5 * p[0] - 1.5 * p[1] + 0.25 * p[2]
 }
 
+/// The tripod with, in `dir`, a Medit solution of [`field`] at its points
+/// (`f.sol`) and one of `1.5 · t` at its tets (`cells.sol`): the mesh and
+/// the two paths.
+fn tripod_with_fields(dir: &Path) -> (TetMesh, PathBuf, PathBuf) {
+    let tripod = input("meshes/tripod.mesh");
+    let fp = dir.join("f.sol");
+    let rows: Vec<Vec<f64>> = tripod
+        .points()
+        .iter()
+        .map(|p| vec![field(p.to_array())])
+        .collect();
+    support::write_sol(&fp, "SolAtVertices", &[1], &rows);
+    let cp = dir.join("cells.sol");
+    let rows: Vec<Vec<f64>> = (0..tripod.n_tets()).map(|t| vec![1.5 * t as f64]).collect();
+    support::write_sol(&cp, "SolAtTetrahedra", &[1], &rows);
+    (tripod, fp, cp)
+}
+
 #[test]
 fn a_gathered_output_carries_fields_and_the_parent_map() {
     let dir = tempfile::tempdir().unwrap();
-    let tripod = input("meshes/tripod.mesh");
+    let (tripod, fp, cp) = tripod_with_fields(dir.path());
     let pts: Vec<[f64; 3]> = tripod.points().iter().map(|p| p.to_array()).collect();
-    let fp = dir.path().join("f.sol");
-    let rows: Vec<Vec<f64>> = pts.iter().map(|&p| vec![field(p)]).collect();
-    support::write_sol(&fp, "SolAtVertices", &[1], &rows);
-    let cp = dir.path().join("cells.sol");
-    let rows: Vec<Vec<f64>> = (0..tripod.n_tets()).map(|t| vec![1.5 * t as f64]).collect();
-    support::write_sol(&cp, "SolAtTetrahedra", &[1], &rows);
     for ranks in [1, 2] {
         let out = dir.path().join(format!("out{ranks}.mesh"));
         let map = dir.path().join(format!("map{ranks}.txt"));
@@ -620,14 +638,8 @@ fn pieces_carry_fields_and_their_own_parent_maps() {
     // tet's centroid, and each piece's map (in its own numbering) gives
     // every point as a barycentric combination of input points.
     let dir = tempfile::tempdir().unwrap();
-    let tripod = input("meshes/tripod.mesh");
+    let (tripod, fp, cp) = tripod_with_fields(dir.path());
     let pts: Vec<[f64; 3]> = tripod.points().iter().map(|p| p.to_array()).collect();
-    let fp = dir.path().join("f.sol");
-    let rows: Vec<Vec<f64>> = pts.iter().map(|&p| vec![field(p)]).collect();
-    support::write_sol(&fp, "SolAtVertices", &[1], &rows);
-    let cp = dir.path().join("cells.sol");
-    let rows: Vec<Vec<f64>> = (0..tripod.n_tets()).map(|t| vec![1.5 * t as f64]).collect();
-    support::write_sol(&cp, "SolAtTetrahedra", &[1], &rows);
     let out = dir.path().join("o.pvtu");
     let map = dir.path().join("map.txt");
     let o = mpirun_ok(
@@ -1029,22 +1041,7 @@ fn a_pvtu_written_on_2_ranks_is_read_back_per_rank_and_refined_again() {
             );
             let (union, pieces) = union_of_pieces(&b);
             assert_eq!(pieces, ranks as usize);
-            let (vol, area) = measures(&union);
-            assert_eq!(
-                vol.keys().collect::<Vec<_>>(),
-                vol_in.keys().collect::<Vec<_>>()
-            );
-            for (r, v) in &vol {
-                assert!(
-                    close(*v, vol_in[r], 1e-9),
-                    "{name} -n {ranks}: region {r}: {v} vs {}",
-                    vol_in[r]
-                );
-            }
-            assert!(
-                close(area, area_in, 1e-9),
-                "{name}: area {area} vs {area_in}"
-            );
+            assert_measures_kept(&format!("{name} -n {ranks}"), &union, &vol_in, area_in);
             let d = final_stats(&stats);
             assert_eq!(d["tets"].as_u64().unwrap() as usize, union.n_tets());
             assert_eq!(d["nodes"].as_u64().unwrap() as usize, union.n_points());
