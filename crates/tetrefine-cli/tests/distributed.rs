@@ -1132,3 +1132,48 @@ fn piece_sources_exist(out: &Path) -> bool {
     let stem = out.file_stem().unwrap().to_string_lossy().into_owned();
     (0..4).any(|r| out.with_file_name(format!("{stem}_{r}.vtu")).exists())
 }
+
+/// A `.pvtu` written on two ranks has had one step (its pieces' `level`):
+/// refined again without `--step-offset`, on two ranks (each reading its
+/// own piece) or serially (reading both), the global count goes on, so the
+/// feature edges are trisected (three times as many, the even-step rule),
+/// and the note says so once.
+#[test]
+fn a_pvtu_refined_again_continues_its_step_count() {
+    let dir = tempfile::tempdir().unwrap();
+    let s = |p: &Path| p.to_str().unwrap().to_string();
+    let a = dir.path().join("a.pvtu");
+    mpirun_ok(2, &["refine", "meshes/tripod.mesh", "-o", &s(&a)]);
+    let stats = dir.path().join("s.json");
+    let serial = serial_ok(&[
+        "refine",
+        &s(&a),
+        "-o",
+        &s(&dir.path().join("s.vtu")),
+        "--stats",
+        &s(&stats),
+    ]);
+    let two = mpirun_ok(
+        2,
+        &[
+            "refine",
+            &s(&a),
+            "-o",
+            &s(&dir.path().join("b.pvtu")),
+            "--stats",
+            &s(&dir.path().join("b.json")),
+        ],
+    );
+    for (what, o, json) in [("serial", &serial, "s.json"), ("2 ranks", &two, "b.json")] {
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(
+            err.matches("has had 1 refinement step").count(),
+            1,
+            "{what}: {err}"
+        );
+        let text = std::fs::read_to_string(dir.path().join(json)).unwrap();
+        let st: serde_json::Value = serde_json::from_str(&text).unwrap();
+        let features = |k: usize| st["steps"][k]["feature_edges"].as_u64().unwrap();
+        assert_eq!(features(1), 3 * features(0), "{what}: trisected");
+    }
+}

@@ -35,12 +35,7 @@ pub fn wanted(a: &Args) -> bool {
         .any(|v| v.trim().parse::<u32>().is_ok_and(|n| n > 1))
 }
 
-/// Whether `p` names a `.pvtu`.
-pub fn is_pvtu(p: &Path) -> bool {
-    p.extension()
-        .and_then(|e| e.to_str())
-        .is_some_and(|e| e.eq_ignore_ascii_case("pvtu"))
-}
+pub use super::pvtu_merge::is_pvtu;
 
 /// The `--stats` file of a distributed run.
 #[derive(serde::Serialize)]

@@ -50,10 +50,7 @@ pub fn load(path: &std::path::Path) -> Result<tetrefine::TetMesh, String> {
 pub fn load_with_meta(
     path: &std::path::Path,
 ) -> Result<(tetrefine::TetMesh, tetrefine::io::MeshMeta), String> {
-    let is_pvtu = path
-        .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("pvtu"));
-    let (mesh, report, meta, notes) = if is_pvtu {
+    let (mesh, report, meta, notes) = if pvtu_merge::is_pvtu(path) {
         // Every piece, joined (see `pvtu_merge`).
         let (data, meta) = pvtu_merge::read_pvtu(path)?;
         let (mesh, report) =

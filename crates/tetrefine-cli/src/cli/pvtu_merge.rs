@@ -10,6 +10,13 @@ const RUN_POINT_ARRAYS: [&str; 1] = ["GlobalPointIds"];
 /// See [`RUN_POINT_ARRAYS`].
 const RUN_CELL_ARRAYS: [&str; 1] = ["rank"];
 
+/// Whether `p` names a `.pvtu`.
+pub fn is_pvtu(p: &std::path::Path) -> bool {
+    p.extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("pvtu"))
+}
+
 /// The names of `pieces`, for a message.
 #[cfg(feature = "mpi")]
 pub fn names(pieces: &[(usize, &PathBuf)]) -> String {

@@ -290,10 +290,7 @@ pub fn run(a: Args) -> super::CliResult {
         return super::distributed::run(a);
     }
     #[cfg(not(feature = "mpi"))]
-    if a.output
-        .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("pvtu"))
-    {
+    if super::pvtu_merge::is_pvtu(&a.output) {
         return Err(format!(
             "{}: a .pvtu is written by distributed runs: build with `--features mpi` and run under mpirun",
             a.output.display()
@@ -517,15 +514,21 @@ pub(super) fn step_offset(a: &Args) -> usize {
 
 /// Whether `p` names a `.vtu` or a `.pvtu`.
 pub(super) fn is_vtu_or_pvtu(p: &std::path::Path) -> bool {
-    p.extension()
-        .and_then(|e| e.to_str())
-        .is_some_and(|e| e.eq_ignore_ascii_case("vtu") || e.eq_ignore_ascii_case("pvtu"))
+    super::pvtu_merge::is_pvtu(p)
+        || p.extension()
+            .and_then(|e| e.to_str())
+            .is_some_and(|e| e.eq_ignore_ascii_case("vtu"))
 }
 
 /// The largest value of the `level` cell array of the `.vtu` (or every
 /// piece of the `.pvtu`) at `path`: the steps tetrefine has made on it. 0
 /// without such an array or with one that is not whole numbers in 0–255.
 pub(super) fn steps_done(path: &std::path::Path) -> usize {
+    if super::pvtu_merge::is_pvtu(path) {
+        // The cell-array reader reads one `.vtu`: the pieces one by one.
+        let pieces = tetrefine::io::read_pvtu_pieces(path).unwrap_or_default();
+        return pieces.iter().map(|p| steps_done(p)).max().unwrap_or(0);
+    }
     let Ok(level) = tetrefine::io::read_tet_cell_array(path, "level") else {
         return 0;
     };
