@@ -125,7 +125,14 @@ pub fn refine_step_with_progress(
 ) -> StepReport {
     let start = Instant::now();
     let mut report = StepReport::default();
-    let floor = worst_dihedral_sine(mesh);
+    // The input's worst, before the phases change the mesh; only a step
+    // that reaches the optimize phase with passes to run needs it.
+    let optimizes = opts.opt_passes > 0 && matches!(opts.stop_after, None | Some(Phase::Optimize));
+    let floor = if optimizes {
+        worst_dihedral_sine(mesh)
+    } else {
+        0.0
+    };
     let mut st = StepState {
         first_barycentre: mesh.n_points() as u32,
         first_face_point: u32::MAX,
