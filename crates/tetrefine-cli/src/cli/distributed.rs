@@ -13,6 +13,7 @@
 
 use super::piece_fields::{locate_pieces, Input, Located};
 use super::progress::BarProgress;
+use super::pvtu_merge::{RUN_CELL_ARRAYS, RUN_POINT_ARRAYS};
 use super::refine::{mark_strategy, selection_of, Args, SmoothScope};
 use super::steps::{peak_rss_bytes, StepStats};
 use std::path::{Path, PathBuf};
@@ -330,12 +331,11 @@ pub fn piece_map_path(map: &Path, rank: u32) -> PathBuf {
     }
 }
 
-/// A field name the pieces' own arrays (`GlobalPointIds`, `rank`) use gets
-/// `_input` appended, as [`super::transfer::vtu_arrays`] does for the
-/// serial arrays.
-fn rename_clashes(fields: &mut [tetrefine::io::Field], taken: &str) {
-    for f in fields.iter_mut().filter(|f| f.name == taken) {
-        f.name = format!("{taken}_input");
+/// A field named like one of the pieces' own arrays (`GlobalPointIds`,
+/// `rank`) gets `_input` appended, as the serial arrays' names do.
+fn rename_clashes(fields: &mut [tetrefine::io::Field], taken: &[&str]) {
+    for f in fields.iter_mut() {
+        f.name = super::transfer::vtu_name(&f.name, taken);
     }
 }
 
@@ -380,8 +380,8 @@ fn write_pieces(
                 &l.locations,
             )?;
         }
-        rename_clashes(&mut l.point_fields, "GlobalPointIds");
-        rename_clashes(&mut l.cell_fields, "rank");
+        rename_clashes(&mut l.point_fields, &RUN_POINT_ARRAYS);
+        rename_clashes(&mut l.cell_fields, &RUN_CELL_ARRAYS);
         let (p, c) = super::transfer::vtu_arrays(
             &|i| l.vertices[i],
             Some(&l.locations),

@@ -6,9 +6,9 @@ use tetrefine::io::{Field, MeshMeta};
 use tetrefine::MeshData;
 
 /// The pieces' own arrays of a distributed run, not fields of the mesh.
-const RUN_POINT_ARRAYS: [&str; 1] = ["GlobalPointIds"];
+pub const RUN_POINT_ARRAYS: [&str; 1] = ["GlobalPointIds"];
 /// See [`RUN_POINT_ARRAYS`].
-const RUN_CELL_ARRAYS: [&str; 1] = ["rank"];
+pub const RUN_CELL_ARRAYS: [&str; 1] = ["rank"];
 
 /// Whether `p` names a `.pvtu`.
 pub fn is_pvtu(p: &std::path::Path) -> bool {

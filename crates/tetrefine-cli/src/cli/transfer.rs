@@ -40,7 +40,7 @@ pub fn transfer_fields(
 
 /// A field name for the `.vtu`: one the writer or the vertex parent map
 /// uses gets `_input` appended.
-fn vtu_name(name: &str, taken: &[&str]) -> String {
+pub(super) fn vtu_name(name: &str, taken: &[&str]) -> String {
     if taken.contains(&name) {
         format!("{name}_input")
     } else {
