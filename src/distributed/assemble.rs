@@ -111,27 +111,10 @@ pub fn assemble(comm: &Comm, mut mesh: TetMesh, first_tet: u32) -> Result<LocalM
 fn shared_slots(comm: &Comm, mesh: &TetMesh) -> Result<MarkerSlots, String> {
     let local =
         comm.agree(MarkerSlots::of(mesh).map_err(|e| format!("rank {}: {e}", comm.rank)))?;
-    let mut w = Wire::default();
-    local.markers.iter().for_each(|&m| w.i32(m));
-    let got = comm.exchange(vec![w.0; comm.size as usize])?;
+    let got = comm.exchange(vec![local.encode(); comm.size as usize])?;
     let mut markers = Vec::new();
     for bytes in &got {
-        let mut r = Reader { bytes, at: 0 };
-        while !r.done() {
-            markers.push(r.i32()?);
-        }
+        MarkerSlots::decode_into(bytes, &mut markers)?;
     }
-    markers.sort_unstable();
-    markers.dedup();
-    let slots = MarkerSlots { markers };
-    let limit = crate::mesh::partition::USER_SLOTS as usize;
-    comm.agree(if slots.markers.len() + 1 > limit {
-        Err(format!(
-            "{} distinct face markers over the pieces; distributed refinement carries at most {}",
-            slots.markers.len(),
-            limit - 1
-        ))
-    } else {
-        Ok(slots)
-    })
+    comm.agree(MarkerSlots::from_markers(markers).map_err(|e| format!("over the pieces: {e}")))
 }

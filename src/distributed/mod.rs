@@ -93,17 +93,9 @@ pub fn distribute(
         _ => Ok((Vec::new(), MarkerSlots::default())),
     };
     let (messages, slots) = comm.agree(prepared)?;
-    let mut w = part::Wire::default();
-    slots.markers.iter().for_each(|&m| w.i32(m));
-    let slot_bytes = comm.broadcast(w.0);
-    let mut r = part::Reader {
-        bytes: &slot_bytes,
-        at: 0,
-    };
+    let slot_bytes = comm.broadcast(slots.encode());
     let mut markers = Vec::new();
-    while !r.done() {
-        markers.push(r.i32()?);
-    }
+    MarkerSlots::decode_into(&slot_bytes, &mut markers)?;
     let slots = MarkerSlots { markers };
     let out = if comm.rank == 0 {
         messages

@@ -60,7 +60,12 @@ impl MarkerSlots {
     /// The table of every non-partition marker of `mesh`; an error when there
     /// are more than a partition marker can name.
     pub fn of(mesh: &TetMesh) -> Result<MarkerSlots, String> {
-        let mut markers: Vec<i32> = mesh.face_markers().values().copied().collect();
+        MarkerSlots::from_markers(mesh.face_markers().values().copied().collect())
+    }
+
+    /// The table of `markers` (any order, repeats allowed); an error as for
+    /// [`MarkerSlots::of`].
+    pub fn from_markers(mut markers: Vec<i32>) -> Result<MarkerSlots, String> {
         markers.sort_unstable();
         markers.dedup();
         if let Some(m) = markers
@@ -80,6 +85,23 @@ impl MarkerSlots {
             ));
         }
         Ok(MarkerSlots { markers })
+    }
+
+    /// The table as a message ([`MarkerSlots::decode_into`] reads it).
+    pub fn encode(&self) -> Vec<u8> {
+        let mut w = Wire::default();
+        self.markers.iter().for_each(|&m| w.i32(m));
+        w.0
+    }
+
+    /// Appends the markers of a message [`MarkerSlots::encode`] made to
+    /// `out`.
+    pub fn decode_into(bytes: &[u8], out: &mut Vec<i32>) -> Result<(), String> {
+        let mut r = Reader { bytes, at: 0 };
+        while !r.done() {
+            out.push(r.i32()?);
+        }
+        Ok(())
     }
 
     /// The slot of user marker `m` (0 for none).
