@@ -80,8 +80,8 @@ pub use refine::features::{detect_features, detect_features_for};
 pub use refine::marking::{doerfler_count, fraction_count, ranking, select, MarkStrategy};
 pub use refine::parents::{contains, walk_to};
 pub use refine::size::{
-    is_positive_definite, size_pass, worst_quality, SizeMap, SizeOptions, SizeReport,
-    AUTO_SIZE_PASSES, SPLIT_ABOVE,
+    is_positive_definite, size_improve_options, size_pass, worst_quality, SizeMap, SizeOptions,
+    SizeReport, AUTO_SIZE_PASSES, SPLIT_ABOVE,
 };
 pub use refine::{
     copy_cell_field, interpolate_point_field, locate_parents, locate_points, refine, refine_step,

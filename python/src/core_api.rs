@@ -612,10 +612,15 @@ pub fn refine(
         // stops when no edge is long or no split was possible.
         let sopts = tetrefine::SizeOptions {
             quality_floor: None,
-            // `effort` and `hausd` as the √3 step's optimize phase.
-            improve: opts
-                .effort
-                .improve_options(a.opt_passes, a.threshold, opts.hausd),
+            // `effort`, `hausd` and the boundary rule as the √3 step's
+            // optimize phase.
+            improve: tetrefine::size_improve_options(
+                opts.effort,
+                a.opt_passes,
+                a.threshold,
+                opts.hausd,
+                opts.boundary,
+            ),
         };
         for s in 1..=a.steps {
             hook(s, "size", mesh.n_tets() as u64);

@@ -104,7 +104,11 @@ pub fn assemble(comm: &Comm, mut mesh: TetMesh, first_tet: u32) -> Result<LocalM
         .map(|(m, _)| m)
         .map_err(|e| format!("rank {me}: its part with the cut marked: {e}"));
     let mesh = comm.agree(built)?;
-    Ok(LocalMesh { mesh, slots })
+    Ok(LocalMesh {
+        mesh,
+        slots,
+        size: None,
+    })
 }
 
 /// The user face markers of every rank's `mesh`, as one slot table.

@@ -148,11 +148,7 @@ fn cut_keys(mesh: &TetMesh) -> CutKeys {
     let corner = pts.iter().map(|&v| mesh.is_corner(v)).collect();
     let edge_keys = edges
         .iter()
-        .map(|&[a, b]| {
-            let mut k = [point_key(mesh.point(a)), point_key(mesh.point(b))];
-            k.sort_unstable();
-            [k[0][0], k[0][1], k[0][2], k[1][0], k[1][1], k[1][2]]
-        })
+        .map(|&[a, b]| edge_coords(mesh, a, b))
         .collect();
     let feature = edges
         .iter()
@@ -165,6 +161,71 @@ fn cut_keys(mesh: &TetMesh) -> CutKeys {
         feature,
         faces: face_keys,
     }
+}
+
+/// Edge `(a, b)` as the sorted keys of its ends: the same on every rank.
+pub(super) fn edge_coords(mesh: &TetMesh, a: u32, b: u32) -> [u64; 6] {
+    let mut k = [point_key(mesh.point(a)), point_key(mesh.point(b))];
+    k.sort_unstable();
+    [k[0][0], k[0][1], k[0][2], k[1][0], k[1][1], k[1][2]]
+}
+
+/// For each `(key, yes)` a rank lists, whether every rank listing the key
+/// said yes (in the order of `votes`): the votes meet at the key's home
+/// rank, which sends the verdict back to each voter.
+pub(super) fn all_holders_agree<const N: usize>(
+    comm: &Comm,
+    votes: &[([u64; N], bool)],
+) -> Result<Vec<bool>, String> {
+    let mut out: Vec<Wire> = (0..comm.size).map(|_| Wire::default()).collect();
+    for (k, yes) in votes {
+        let w = &mut out[home(k, comm.size)];
+        k.iter().for_each(|&x| w.u64(x));
+        w.u32(u32::from(*yes));
+    }
+    let got = comm.exchange(out.into_iter().map(|w| w.0).collect())?;
+    let mut tally: BTreeMap<[u64; N], (bool, Vec<u32>)> = BTreeMap::new();
+    for (rank, bytes) in got.iter().enumerate() {
+        let mut r = Reader { bytes, at: 0 };
+        while !r.done() {
+            let mut k = [0u64; N];
+            for x in &mut k {
+                *x = r.u64()?;
+            }
+            let yes = r.u32()? == 1;
+            let e = tally.entry(k).or_insert((true, Vec::new()));
+            e.0 &= yes;
+            e.1.push(rank as u32);
+        }
+    }
+    let mut back: Vec<Wire> = (0..comm.size).map(|_| Wire::default()).collect();
+    for (k, (yes, voters)) in &tally {
+        for &v in voters {
+            k.iter().for_each(|&x| back[v as usize].u64(x));
+            back[v as usize].u32(u32::from(*yes));
+        }
+    }
+    let got = comm.exchange(back.into_iter().map(|w| w.0).collect())?;
+    let mut verdict: FastHashMap<[u64; N], bool> = FastHashMap::default();
+    for bytes in &got {
+        let mut r = Reader { bytes, at: 0 };
+        while !r.done() {
+            let mut k = [0u64; N];
+            for x in &mut k {
+                *x = r.u64()?;
+            }
+            verdict.insert(k, r.u32()? == 1);
+        }
+    }
+    votes
+        .iter()
+        .map(|(k, _)| {
+            verdict
+                .get(k)
+                .copied()
+                .ok_or_else(|| format!("rank {}: a vote came back without a verdict", comm.rank))
+        })
+        .collect()
 }
 
 pub(super) fn flat(k: &FaceCoords) -> [u64; 9] {

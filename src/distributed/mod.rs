@@ -38,15 +38,18 @@ mod comm;
 mod cut;
 mod part;
 mod partition;
+mod size;
 
 pub use assemble::assemble;
 pub use comm::{failure_printed, Comm, OTHER_RANK_FAILED};
 pub use cut::{census, global_point_ids, global_stats, Census};
 pub use part::{point_key, MarkerSlots, Part, PointKey, Reader, Wire};
 pub use partition::partition_dual_graph;
+pub use size::{size_distributed, DistributedSizeOptions, SizePassReport};
 
 use crate::mesh::partition::PartitionMarker;
 use crate::mesh::TetMesh;
+use crate::refine::size::SizeMap;
 use crate::refine::step::descendants_of_last_step;
 use crate::report::MeshStats;
 use crate::{RefineOptions, StepReport};
@@ -59,6 +62,8 @@ pub struct LocalMesh {
     pub mesh: TetMesh,
     /// The user markers partition faces carry, by slot.
     pub slots: MarkerSlots,
+    /// The size map over this rank's points, in a size-driven run.
+    pub size: Option<SizeMap>,
 }
 
 /// How often the cut moves after the last step, each move followed by the
@@ -80,15 +85,17 @@ pub struct DistributedOptions {
 }
 
 /// Splits rank 0's `input` into one part per rank, METIS on the dual graph
-/// weighted by the work each tet brings; every rank gets its part.
+/// weighted by the work each tet brings; every rank gets its part, with its
+/// points' entries of rank 0's `size` map when there is one.
 pub fn distribute(
     comm: &Comm,
     input: Option<&TetMesh>,
     selection: Option<&[bool]>,
+    size: Option<&SizeMap>,
     steps: usize,
 ) -> Result<(LocalMesh, Option<Vec<bool>>), String> {
     let prepared = match input {
-        Some(mesh) if comm.rank == 0 => prepare_parts(comm.size, mesh, selection, steps),
+        Some(mesh) if comm.rank == 0 => prepare_parts(comm.size, mesh, selection, size, steps),
         _ if comm.rank == 0 => Err("rank 0 holds no input mesh".to_string()),
         _ => Ok((Vec::new(), MarkerSlots::default())),
     };
@@ -104,25 +111,34 @@ pub fn distribute(
     };
     let got = comm.exchange(out)?;
     let built = Part::decode(&got[0])
-        .and_then(Part::build)
+        .and_then(|mut p| {
+            let size = p.sizes.take();
+            p.build().map(|(m, s)| (m, s, size))
+        })
         .map_err(|e| format!("rank {}: its part: {e}", comm.rank));
-    let (mesh, selected) = comm.agree(built)?;
+    let (mesh, selected, size) = comm.agree(built)?;
     // Only rank 0 knows whether the run is adaptive.
     let adaptive = comm.sum(&[u64::from(comm.rank == 0 && selection.is_some())])[0] > 0;
     let selected = adaptive.then_some(selected);
-    Ok((LocalMesh { mesh, slots }, selected))
+    Ok((LocalMesh { mesh, slots, size }, selected))
 }
 
 /// Rank 0's side of [`distribute`]: one encoded part per rank.
 fn prepare_parts(
-    size: u32,
+    ranks: u32,
     mesh: &TetMesh,
     selection: Option<&[bool]>,
+    size: Option<&SizeMap>,
     steps: usize,
 ) -> Result<(Vec<Vec<u8>>, MarkerSlots), String> {
     let slots = MarkerSlots::of(mesh)?;
     let ids: Vec<u32> = mesh.tet_ids().collect();
-    let grow = 6i32.saturating_pow(steps.min(8) as u32);
+    // A refined tet weighs what it grows into, but METIS sums the weights
+    // in 32 bits: the growth is capped so that the total stays below half
+    // of `i32::MAX` (20 size passes on 15k tets overflowed it, and METIS
+    // left a rank empty).
+    let cap = (i64::from(i32::MAX) / 2 / ids.len().max(1) as i64).max(1);
+    let grow = i64::from(6i32.saturating_pow(steps.min(8) as u32)).min(cap) as i32;
     let weight: Vec<i32> = ids
         .iter()
         .map(|&t| match selection {
@@ -130,12 +146,12 @@ fn prepare_parts(
             _ => grow,
         })
         .collect();
-    let part_of_dense = partition_dual_graph(mesh, size, &weight)?;
+    let part_of_dense = partition_dual_graph(mesh, ranks, &weight)?;
     let mut part_of = vec![0u32; mesh.n_tet_slots()];
     for (i, &t) in ids.iter().enumerate() {
         part_of[t as usize] = part_of_dense[i];
     }
-    let mut by_rank: Vec<Vec<u32>> = vec![Vec::new(); size as usize];
+    let mut by_rank: Vec<Vec<u32>> = vec![Vec::new(); ranks as usize];
     for &t in &ids {
         by_rank[part_of[t as usize] as usize].push(t);
     }
@@ -161,6 +177,9 @@ fn prepare_parts(
                 });
                 // The input tet's own id: the `parent` of every descendant.
                 p.parent = tets.clone();
+                if let Some(m) = size {
+                    p.attach_sizes(mesh, tets, m);
+                }
                 p.encode()
             })
             .collect(),
@@ -374,7 +393,7 @@ fn migrate_cut_layer(comm: &Comm, local: &mut LocalMesh, layers: usize) -> Resul
     let mut parts: Vec<Part> = by_rank
         .iter()
         .map(|tets| {
-            Part::from_tets(mesh, tets, &local.slots, None, |t, f| {
+            let mut part = Part::from_tets(mesh, tets, &local.slots, None, |t, f| {
                 let h = mesh.adj(t)[f];
                 let other = if h == crate::NO_ADJ {
                     let fv = mesh.face_vertices(t, f);
@@ -399,7 +418,11 @@ fn migrate_cut_layer(comm: &Comm, local: &mut LocalMesh, layers: usize) -> Resul
                 } else {
                     FaceFate::Cut(other)
                 }
-            })
+            });
+            if let Some(m) = &local.size {
+                part.attach_sizes(mesh, tets, m);
+            }
+            part
         })
         .collect();
     comm.agree(if unmatched > 0 {
@@ -435,7 +458,9 @@ fn migrate_cut_layer(comm: &Comm, local: &mut LocalMesh, layers: usize) -> Resul
         }
     }
     all.retain(|p| !p.data.tets.is_empty());
-    let rebuilt = Part::merge(all).build().map(|(m, _)| m);
+    let mut merged = Part::merge(all);
+    local.size = merged.sizes.take();
+    let rebuilt = merged.build().map(|(m, _)| m);
     local.mesh = comm.agree(rebuilt)?;
     Ok(true)
 }

@@ -13,6 +13,7 @@
 use crate::mesh::fasthash::FastHashMap;
 use crate::mesh::partition::PartitionMarker;
 use crate::mesh::{edge_key, face_key, MeshData, TetMesh, NO_ADJ};
+use crate::refine::size::SizeMap;
 use crate::topo::{TET_EDGES, TET_FACES};
 use glam::DVec3;
 use std::collections::HashSet;
@@ -138,6 +139,9 @@ pub struct Part {
     pub parent: Vec<u32>,
     /// Per tet: selected for the first step (empty: uniform).
     pub selected: Vec<bool>,
+    /// Per point: its entry of the run's size map (`None`: the run has
+    /// none), so that a size-driven run's targets travel with the points.
+    pub sizes: Option<SizeMap>,
 }
 
 impl Part {
@@ -151,17 +155,8 @@ impl Part {
         selected: Option<&[bool]>,
         mut fate: impl FnMut(u32, usize) -> FaceFate,
     ) -> Part {
-        let mut local: FastHashMap<u32, u32> = FastHashMap::default();
-        let mut points = Vec::new();
-        let mut out_tets = Vec::with_capacity(tets.len());
-        for &t in tets {
-            out_tets.push(mesh.tet(t).map(|v| {
-                *local.entry(v).or_insert_with(|| {
-                    points.push(mesh.point(v).to_array());
-                    points.len() as u32 - 1
-                })
-            }));
-        }
+        let (out_tets, source, local) = local_numbering(mesh, tets);
+        let points = source.iter().map(|&v| mesh.point(v).to_array()).collect();
         let has_markers = !mesh.face_markers().is_empty();
         let mut triangles = Vec::new();
         let mut seen_interior: HashSet<[u32; 3]> = HashSet::new();
@@ -240,7 +235,15 @@ impl Part {
                     .map(|&t| s.get(t as usize).copied().unwrap_or(false))
                     .collect()
             }),
+            sizes: None,
         }
+    }
+
+    /// Gives the part built by [`Part::from_tets`] from `mesh`'s `tets` the
+    /// entries of `size` (a size map over `mesh`'s points) of its points.
+    pub fn attach_sizes(&mut self, mesh: &TetMesh, tets: &[u32], size: &SizeMap) {
+        let (_, source, _) = local_numbering(mesh, tets);
+        self.sizes = Some(size.gather(&source));
     }
 
     /// One part holding the tets of all `parts`, points with the same
@@ -253,6 +256,12 @@ impl Part {
         let mut corners = HashSet::new();
         let mut required = HashSet::new();
         let uniform = parts.iter().all(|p| p.selected.is_empty());
+        // Sizes only when every part has a map of the same kind.
+        let kind = |p: &Part| p.sizes.as_ref().map(SizeMap::components);
+        out.sizes = parts
+            .first()
+            .filter(|first| kind(first).is_some() && parts.iter().all(|p| kind(p) == kind(first)))
+            .and_then(|first| first.sizes.as_ref().map(SizeMap::empty_like));
         for p in parts {
             let ids: Vec<u32> = p
                 .data
@@ -267,6 +276,15 @@ impl Part {
                         })
                 })
                 .collect();
+            if let (Some(to), Some(from)) = (out.sizes.as_mut(), p.sizes.as_ref()) {
+                // A point's first part gives its size (both sides of a cut
+                // carry the same entry).
+                for (i, &id) in ids.iter().enumerate() {
+                    if id as usize == to.len() {
+                        to.push_entry(from, i);
+                    }
+                }
+            }
             out.data
                 .tets
                 .extend(p.data.tets.iter().map(|t| t.map(|v| ids[v as usize])));
@@ -343,6 +361,13 @@ impl Part {
             w.u64(list.len() as u64);
             list.iter().for_each(|&v| w.u32(v));
         }
+        match &self.sizes {
+            None => w.u32(0),
+            Some(m) => {
+                w.u32(m.components() as u32);
+                (0..m.len()).for_each(|i| m.entry(i).iter().for_each(|&x| w.f64(x)));
+            }
+        }
         w.0
     }
 
@@ -382,6 +407,16 @@ impl Part {
             let n = r.count(4)?;
             lists.push((0..n).map(|_| r.u32()).collect::<Result<Vec<_>, _>>()?);
         }
+        let sizes = match r.u32()? {
+            0 => None,
+            c @ (1 | 6) => {
+                let values = (0..np * c as usize)
+                    .map(|_| r.f64())
+                    .collect::<Result<Vec<_>, _>>()?;
+                Some(SizeMap::from_values(c as usize, &values)?)
+            }
+            c => return Err(format!("a size map of {c} components")),
+        };
         if r.at != bytes.len() {
             return Err(format!(
                 "{} bytes after the end of a part",
@@ -404,8 +439,32 @@ impl Part {
             level,
             parent,
             selected,
+            sizes,
         })
     }
+}
+
+/// `tets` of `mesh` renumbered for a part: each tet's local vertex ids, the
+/// mesh's id of every local point (in order of first use), and the map
+/// from the mesh's ids to the local ones.
+fn local_numbering(
+    mesh: &TetMesh,
+    tets: &[u32],
+) -> (Vec<[u32; 4]>, Vec<u32>, FastHashMap<u32, u32>) {
+    let mut local: FastHashMap<u32, u32> = FastHashMap::default();
+    let mut source = Vec::new();
+    let out_tets = tets
+        .iter()
+        .map(|&t| {
+            mesh.tet(t).map(|v| {
+                *local.entry(v).or_insert_with(|| {
+                    source.push(v);
+                    source.len() as u32 - 1
+                })
+            })
+        })
+        .collect();
+    (out_tets, source, local)
 }
 
 /// A little-endian byte writer.
@@ -520,6 +579,24 @@ mod tests {
                 .iter()
                 .all(|&(_, m)| m == partition_marker(1 - r)));
             parts.push(p);
+        }
+        // Sizes travel with the points: a size per point from its
+        // coordinates comes back at every point of the merged part.
+        let h = |p: [f64; 3]| 1.0 + p[0] + 10.0 * p[1] + 100.0 * p[2];
+        let size = SizeMap::Iso(mesh.points().iter().map(|p| h(p.to_array())).collect());
+        let mut sized = Vec::new();
+        for (r, p) in parts.iter().enumerate() {
+            let tets: Vec<u32> = (0..n).filter(|&t| half(t) == r as u32).collect();
+            let mut q = p.clone();
+            q.attach_sizes(&mesh, &tets, &size);
+            assert_eq!(Part::decode(&q.encode()).unwrap(), q);
+            sized.push(q);
+        }
+        let merged = Part::merge(sized);
+        let got = merged.sizes.expect("every part had sizes");
+        assert_eq!(got.len(), merged.data.points.len());
+        for (i, p) in merged.data.points.iter().enumerate() {
+            assert_eq!(got.entry(i), &[h(*p)]);
         }
         let cut = parts[0].data.triangles.len();
         assert_eq!(cut, parts[1].data.triangles.len());

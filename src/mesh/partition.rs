@@ -91,6 +91,24 @@ pub fn is_partition_marker(m: i32) -> bool {
     PartitionMarker::decode(m).is_some()
 }
 
+/// The edges of every partition face of `mesh` (none when no marker is a
+/// partition marker): the edges no operation may split, flip or trisect,
+/// since the rank across would not do the same.
+pub(crate) fn partition_edges(mesh: &super::TetMesh) -> std::collections::HashSet<[u32; 2]> {
+    use crate::topo::edge_key;
+    mesh.face_markers()
+        .iter()
+        .filter(|(_, &m)| is_partition_marker(m))
+        .flat_map(|(f, _)| {
+            [
+                edge_key(f[0], f[1]),
+                edge_key(f[1], f[2]),
+                edge_key(f[0], f[2]),
+            ]
+        })
+        .collect()
+}
+
 /// The centroid of a triangle computed from its corners sorted by their
 /// coordinates: the same bits whichever order the caller lists them in
 /// (floating-point addition is commutative but not associative, so

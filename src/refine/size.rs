@@ -171,6 +171,51 @@ impl SizeMap {
         lt.is_finite().then_some(lt)
     }
 
+    /// Values per point: 1 (a length) or 6 (a metric).
+    pub fn components(&self) -> usize {
+        match self {
+            SizeMap::Iso(_) => 1,
+            SizeMap::Aniso(_) => 6,
+        }
+    }
+
+    /// The values of point `i` ([`SizeMap::components`] of them).
+    pub fn entry(&self, i: usize) -> &[f64] {
+        match self {
+            SizeMap::Iso(h) => std::slice::from_ref(&h[i]),
+            SizeMap::Aniso(m) => &m[i],
+        }
+    }
+
+    /// An empty map of the same kind.
+    #[cfg(feature = "mpi")]
+    pub(crate) fn empty_like(&self) -> SizeMap {
+        match self {
+            SizeMap::Iso(_) => SizeMap::Iso(Vec::new()),
+            SizeMap::Aniso(_) => SizeMap::Aniso(Vec::new()),
+        }
+    }
+
+    /// The entries of points `ids`, in that order.
+    #[cfg(feature = "mpi")]
+    pub(crate) fn gather(&self, ids: &[u32]) -> SizeMap {
+        match self {
+            SizeMap::Iso(h) => SizeMap::Iso(ids.iter().map(|&v| h[v as usize]).collect()),
+            SizeMap::Aniso(m) => SizeMap::Aniso(ids.iter().map(|&v| m[v as usize]).collect()),
+        }
+    }
+
+    /// Appends point `i` of `from`, a map of the same kind (of the other
+    /// kind, nothing: callers check the kinds first).
+    #[cfg(feature = "mpi")]
+    pub(crate) fn push_entry(&mut self, from: &SizeMap, i: usize) {
+        match (self, from) {
+            (SizeMap::Iso(to), SizeMap::Iso(h)) => to.push(h[i]),
+            (SizeMap::Aniso(to), SizeMap::Aniso(m)) => to.push(m[i]),
+            _ => debug_assert!(false, "size maps of two kinds"),
+        }
+    }
+
     /// Appends the size of a new point halfway between `a` and `b`.
     fn push_mean(&mut self, a: u32, b: u32) {
         match self {
@@ -232,6 +277,10 @@ pub struct SizeReport {
     pub refused: usize,
     /// Edges still longer than [`SPLIT_ABOVE`] after the pass.
     pub long_after: usize,
+    /// Long edges left whole because they lie on a partition face (a
+    /// distributed part's cut, which the rank across must split too); they
+    /// count in `long_edges`, not in `refused`.
+    pub on_cut: usize,
 }
 
 /// Options of [`size_pass`].
@@ -244,6 +293,25 @@ pub struct SizeOptions {
     /// The optimize phase after the splits (`passes: 0` skips it; vertex
     /// insertion is off there whatever this says, see [`size_pass`]).
     pub improve: ImproveOptions,
+}
+
+/// The optimize phase of the size passes: `effort`'s options with
+/// `passes`, `threshold` and `hausd`, no vertex insertion (an inserted
+/// point would have no size), and with the linear `boundary` rule the
+/// domain kept exactly, as the √3 step keeps it.
+pub fn size_improve_options(
+    effort: crate::improve::Effort,
+    passes: usize,
+    threshold: f64,
+    hausd: Option<f64>,
+    boundary: crate::stencil::Sqrt3Rule,
+) -> ImproveOptions {
+    let mut io = ImproveOptions {
+        insert_vertices: false,
+        ..effort.improve_options(passes, threshold, hausd)
+    };
+    super::step::keep_domain_for(&mut io, boundary);
+    io
 }
 
 /// The long edges of `mesh`, longest first (ties by vertex ids).
@@ -290,6 +358,61 @@ pub fn worst_metric_quality(mesh: &TetMesh, size: &SizeMap) -> f64 {
         .fold(f64::INFINITY, f64::min)
 }
 
+/// The worst quality (in the metric of the edge) of the tets that
+/// splitting edge `(a, b)` at its midpoint would make, or `None` when the
+/// edge is not in the mesh. `shell` is scratch space.
+pub(crate) fn split_quality(
+    mesh: &TetMesh,
+    size: &SizeMap,
+    a: u32,
+    b: u32,
+    shell: &mut Vec<u32>,
+) -> Option<f64> {
+    mesh.ball(a, shell);
+    shell.retain(|&t| mesh.tet(t).contains(&b));
+    if shell.is_empty() {
+        return None;
+    }
+    let mid = (mesh.point(a) + mesh.point(b)) * 0.5;
+    let tr = size.transform(&[a, b]);
+    let worst = shell
+        .iter()
+        .flat_map(|&t| {
+            let v = mesh.tet(t);
+            let p = mesh.tet_points(t);
+            let mut p1 = p;
+            let mut p2 = p;
+            for i in 0..4 {
+                if v[i] == b {
+                    p1[i] = mid;
+                }
+                if v[i] == a {
+                    p2[i] = mid;
+                }
+            }
+            [quality_in(tr, p1), quality_in(tr, p2)]
+        })
+        .fold(f64::INFINITY, f64::min);
+    Some(worst)
+}
+
+/// Splits edge `(a, b)` at its midpoint, the new point's size the mean of
+/// the ends'; an error (nothing changed) when [`split_edge`] refuses.
+/// The midpoint is `(pa + pb) * 0.5`, the same bits whichever end comes
+/// first (floating-point addition is commutative), so two ranks splitting
+/// the same edge of their cut create the same point.
+pub(crate) fn split_at_midpoint(
+    mesh: &mut TetMesh,
+    size: &mut SizeMap,
+    a: u32,
+    b: u32,
+) -> Result<(), crate::ops::OpError> {
+    let mid = (mesh.point(a) + mesh.point(b)) * 0.5;
+    split_edge(mesh, a, b, mid)?;
+    size.push_mean(a, b);
+    Ok(())
+}
+
 /// One size pass (see the module documentation). `size` covers the points
 /// of `mesh` and grows with it.
 pub fn size_pass(mesh: &mut TetMesh, size: &mut SizeMap, opts: &SizeOptions) -> SizeReport {
@@ -302,47 +425,23 @@ pub fn size_pass(mesh: &mut TetMesh, size: &mut SizeMap, opts: &SizeOptions) -> 
         long_edges: long.len(),
         ..SizeReport::default()
     };
+    let cut = crate::mesh::partition::partition_edges(mesh);
     let mut shell = Vec::new();
     for (_, [a, b]) in long {
-        // An earlier split may have cut this edge already.
-        mesh.ball(a, &mut shell);
-        shell.retain(|&t| mesh.tet(t).contains(&b));
-        if shell.is_empty() {
+        if cut.contains(&[a, b]) {
+            report.on_cut += 1;
             continue;
         }
-        let (pa, pb) = (mesh.point(a), mesh.point(b));
-        let mid = (pa + pb) * 0.5;
-        // The pieces' quality (in the metric of the edge), before
-        // splitting: refuse below the floor.
-        let tr = size.transform(&[a, b]);
-        let worst_new = shell
-            .iter()
-            .flat_map(|&t| {
-                let v = mesh.tet(t);
-                let p = mesh.tet_points(t);
-                let mut p1 = p;
-                let mut p2 = p;
-                for i in 0..4 {
-                    if v[i] == b {
-                        p1[i] = mid;
-                    }
-                    if v[i] == a {
-                        p2[i] = mid;
-                    }
-                }
-                [quality_in(tr, p1), quality_in(tr, p2)]
-            })
-            .fold(f64::INFINITY, f64::min);
+        // An earlier split may have cut this edge already.
+        let Some(worst_new) = split_quality(mesh, size, a, b, &mut shell) else {
+            continue;
+        };
         if worst_new < floor {
             report.refused += 1;
-            continue;
-        }
-        match split_edge(mesh, a, b, mid) {
-            Ok(_) => {
-                size.push_mean(a, b);
-                report.split += 1;
-            }
-            Err(_) => report.refused += 1,
+        } else if split_at_midpoint(mesh, size, a, b).is_ok() {
+            report.split += 1;
+        } else {
+            report.refused += 1;
         }
     }
     if opts.improve.passes > 0 {

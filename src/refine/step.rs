@@ -4,7 +4,7 @@ use super::{InterfaceRule, NoProgress, Phase, PhaseReport, Progress, RefineOptio
 use crate::improve::{improve, ImproveOptions};
 use crate::mesh::ball_stays_positive;
 use crate::mesh::fasthash::FastHashMap;
-use crate::mesh::partition::{canonical_centroid, is_partition_marker, PartitionMarker};
+use crate::mesh::partition::{canonical_centroid, partition_edges, PartitionMarker};
 use crate::mesh::{edge_key, TetMarks, TetMesh};
 use crate::ops::{
     flip23_bulk, make_flips_valid, remove_edge, remove_interface_edge, split14_bulk,
@@ -222,15 +222,7 @@ pub(crate) fn optimize_phase(
             opts.hausd,
         )
     };
-    if matches!(opts.boundary, crate::stencil::Sqrt3Rule::Linear) {
-        // The linear rule promises the input's domain: a
-        // boundary vertex moves only inside a flat star, so
-        // no crease, however shallow, is cut.
-        if let Some(b) = &mut io.boundary {
-            b.crease_angle = crate::improve::boundary_smooth::FLAT_ONLY;
-            b.remove_caps = false;
-        }
-    }
+    keep_domain_for(&mut io, opts.boundary);
     // Long edges are split once the passes have evened out the
     // step's new points (split on the raw √3 mesh they gain
     // half as much: tripod 41.6° against 43.4° average), then
@@ -260,6 +252,18 @@ pub(crate) fn optimize_phase(
         report.add(&second);
     }
     report
+}
+
+/// The linear rule promises the input's domain: a boundary vertex moves
+/// only inside a flat star, so no crease, however shallow, is cut, and no
+/// cap is removed. The other rules leave `io` as it is.
+pub(crate) fn keep_domain_for(io: &mut ImproveOptions, rule: crate::stencil::Sqrt3Rule) {
+    if matches!(rule, crate::stencil::Sqrt3Rule::Linear) {
+        if let Some(b) = &mut io.boundary {
+            b.crease_angle = crate::improve::boundary_smooth::FLAT_ONLY;
+            b.remove_caps = false;
+        }
+    }
 }
 
 /// The highest smoothing bar (min sine, about 21°) an input's worst tet
@@ -343,22 +347,6 @@ fn flip_phase(mesh: &mut TetMesh, st: &StepState, report: &mut StepReport) {
     let flipped = flip23_bulk(mesh, batch);
     report.flipped += flipped;
     report.refused_flips += n - flipped;
-}
-
-/// The edges of every partition face of `mesh` (none when no marker is a
-/// partition marker).
-fn partition_edges(mesh: &TetMesh) -> HashSet<[u32; 2]> {
-    mesh.face_markers()
-        .iter()
-        .filter(|(_, &m)| is_partition_marker(m))
-        .flat_map(|(f, _)| {
-            [
-                edge_key(f[0], f[1]),
-                edge_key(f[1], f[2]),
-                edge_key(f[0], f[2]),
-            ]
-        })
-        .collect()
 }
 
 /// The partition marker of face `fv`, if it has one.

@@ -51,25 +51,8 @@ struct StatsFile<'a> {
     seconds: f64,
 }
 
-/// Options of the serial command that have no distributed meaning yet.
-fn refuse_serial_only(a: &Args) -> super::CliResult {
-    let refused = [
-        ("--size", a.size.is_some()),
-        ("--size-array", a.size_array.is_some()),
-        ("--hsiz", a.hsiz.is_some()),
-        ("--hmax", a.hmax.is_some()),
-    ];
-    if let Some((name, _)) = refused.iter().find(|(_, on)| *on) {
-        return Err(format!(
-            "{name} is not available in a distributed run (mpirun or a .pvtu output); run it serially"
-        ));
-    }
-    Ok(())
-}
-
 /// Runs `refine` distributed.
 pub fn run(a: Args) -> super::CliResult {
-    refuse_serial_only(&a)?;
     let pieces = is_pvtu(&a.output);
     let pvtu_in = super::pvtu_input::per_rank(&a);
     if !pieces {
@@ -79,15 +62,13 @@ pub fn run(a: Args) -> super::CliResult {
     if let Some(f) = &a.features_out {
         tetrefine::PolylineFormat::of(f).map_err(|e| e.to_string())?;
     }
-    let n_steps = match a.steps {
-        Some(super::size::Steps::N(n)) => n,
-        None => 1,
-        Some(super::size::Steps::Auto) => {
-            return Err("--steps auto needs a size map, which distributed runs do not take".into())
-        }
-    };
-    if n_steps == 0 && !a.allow_steps_zero {
-        return Err("--steps 0 refines nothing; give --steps N ≥ 1 (or --allow-steps-zero to write the mesh unrefined)".into());
+    let plan = super::size::plan(&a)?;
+    let n_steps = plan.n_steps;
+    if pvtu_in && (a.size.is_some() || a.size_array.is_some()) {
+        return Err(format!(
+            "{} is read per rank (a .pvtu input with a .pvtu output), and --size/--size-array number the points of one whole mesh: write a .vtu output (rank 0 reads the whole input), or give --hsiz/--hmax",
+            a.input.display()
+        ));
     }
     if let Some(h) = &a.histogram {
         super::check_histogram_path(h)?;
@@ -100,7 +81,9 @@ pub fn run(a: Args) -> super::CliResult {
     let mut steps = Vec::new();
     let (mut input, meta, selection, transfer, mut local, first_selection) = if pvtu_in {
         // Every rank reads its own pieces; nobody holds the whole input.
-        let local = super::pvtu_input::load_pieces(&comm, &a)?;
+        let mut local = super::pvtu_input::load_pieces(&comm, &a)?;
+        local.size =
+            super::size::size_map(None, None, a.hsiz, a.hmax, &local.mesh, &Default::default())?;
         let c = dist::census(&comm, &local.mesh)?;
         let first = dist::global_stats(&comm, &local.mesh, &c)?;
         if root {
@@ -117,9 +100,9 @@ pub fn run(a: Args) -> super::CliResult {
             Ok(None)
         };
         let loaded = comm.agree(loaded)?;
-        let (input, meta, selection, transfer) = match loaded {
-            Some((m, meta, s, t)) => (Some(m), meta, s, t),
-            None => (None, Default::default(), None, false),
+        let (input, meta, selection, transfer, size) = match loaded {
+            Some((m, meta, s, t, size)) => (Some(m), meta, s, t, size),
+            None => (None, Default::default(), None, false, None),
         };
         if let Some(m) = &input {
             let first = MeshStats::compute(m);
@@ -132,8 +115,16 @@ pub fn run(a: Args) -> super::CliResult {
                 comm.size
             );
         }
-        let (local, first_selection) =
-            dist::distribute(&comm, input.as_ref(), selection.as_deref(), n_steps)?;
+        // Size passes split where the map says, not uniformly: every tet
+        // weighs alike (as one step's growth).
+        let growth_steps = if plan.size_given { 1 } else { n_steps };
+        let (local, first_selection) = dist::distribute(
+            &comm,
+            input.as_ref(),
+            selection.as_deref(),
+            size.as_ref(),
+            growth_steps,
+        )?;
         (input, meta, selection, transfer, local, first_selection)
     };
     // Pieces are located in the input (on rank 0) only for the parent map
@@ -184,34 +175,40 @@ pub fn run(a: Args) -> super::CliResult {
         // A step stopped early has not optimised: the cut stays.
         improve_across_cut: a.stop_after.is_none(),
     };
-    // Rank 0's phases drive the bar (the parts are balanced by METIS).
-    let bar = root.then(|| BarProgress::new(n_steps, tetrefine::Phase::ALL.len()));
-    let progress: &dyn tetrefine::Progress = match &bar {
-        Some(b) => b,
-        None => &tetrefine::NoProgress,
+    let (census, last, moved) = if plan.size_given {
+        let (census, last) = size_loop(&comm, &mut local, &a, &plan, &mut steps)?;
+        (census, last, false)
+    } else {
+        // Rank 0's phases drive the bar (the parts are balanced by METIS).
+        let bar = root.then(|| BarProgress::new(n_steps, tetrefine::Phase::ALL.len()));
+        let progress: &dyn tetrefine::Progress = match &bar {
+            Some(b) => b,
+            None => &tetrefine::NoProgress,
+        };
+        let (census, last) = dist::refine_distributed(
+            &comm,
+            &mut local,
+            first_selection,
+            &opts,
+            progress,
+            |s, stats, report| {
+                if let Some(b) = &bar {
+                    b.suspend(|| {
+                        crate::say!("{}", step_row(&format!("step {s}"), stats, report.seconds))
+                    });
+                    steps.push(StepStats::step(stats.clone(), report));
+                }
+            },
+        )?;
+        if let Some(b) = &bar {
+            b.finish();
+        }
+        let moved = comm.size > 1 && n_steps > 0;
+        if root && moved {
+            crate::say!("{}", step_row("cut", &last, 0.0));
+        }
+        (census, last, moved)
     };
-    let (census, last) = dist::refine_distributed(
-        &comm,
-        &mut local,
-        first_selection,
-        &opts,
-        progress,
-        |s, stats, report| {
-            if let Some(b) = &bar {
-                b.suspend(|| {
-                    crate::say!("{}", step_row(&format!("step {s}"), stats, report.seconds))
-                });
-                steps.push(StepStats::step(stats.clone(), report));
-            }
-        },
-    )?;
-    if let Some(b) = &bar {
-        b.finish();
-    }
-    let moved = comm.size > 1 && n_steps > 0;
-    if root && moved {
-        crate::say!("{}", step_row("cut", &last, 0.0));
-    }
     if root && comm.size > 1 {
         eprintln!(
             "cut: {} partition faces ({:.2} % of the {} interior faces)",
@@ -288,6 +285,62 @@ pub fn run(a: Args) -> super::CliResult {
     Ok(())
 }
 
+/// The size passes of a run with a size map ([`dist::size_distributed`]):
+/// a row per pass from rank 0, and the serial command's notes.
+fn size_loop(
+    comm: &Comm,
+    local: &mut LocalMesh,
+    a: &Args,
+    plan: &super::size::Plan,
+    steps: &mut Vec<StepStats>,
+) -> Result<(dist::Census, MeshStats), String> {
+    let root = comm.rank == 0;
+    let opts = dist::DistributedSizeOptions {
+        passes: plan.n_steps,
+        until_met: plan.auto,
+        improve: tetrefine::size_improve_options(
+            a.effort,
+            a.opt_passes,
+            a.threshold,
+            a.hausd,
+            a.boundary,
+        ),
+    };
+    let mut said_moves = 0;
+    let (census, last, r) = dist::size_distributed(comm, local, &opts, |s, stats, r, secs| {
+        if !root {
+            return;
+        }
+        if r.cut_moves > said_moves {
+            eprintln!(
+                "the cut moved ({}): the band it froze is improved, the passes go on",
+                r.cut_moves
+            );
+            said_moves = r.cut_moves;
+        }
+        crate::say!("{}", step_row(&format!("size {s}"), stats, secs));
+        eprintln!(
+            "size pass {s}: {} long edges, {} split, {} refused (would invert a tet or fall below the worst quality so far, measured in the metric), {} still long, {} on the cut still long",
+            r.long_edges, r.split, r.refused, r.long_after, r.long_on_cut
+        );
+        let report = tetrefine::StepReport {
+            seconds: secs,
+            ..tetrefine::StepReport::default()
+        };
+        steps.push(StepStats::step(stats.clone(), &report));
+    })?;
+    if root {
+        super::size::note_still_long(r.long_after, r.split == 0, plan);
+        if r.long_on_cut > 0 {
+            eprintln!(
+                "note: {} long edges lie on the cut between ranks where it ended; they stay whole (refining the output again splits them)",
+                r.long_on_cut
+            );
+        }
+    }
+    Ok((census, last))
+}
+
 /// Rank 0's input, its metadata (with `--fields`), the selection and
 /// whether the fields are carried over.
 type Loaded = (
@@ -295,9 +348,10 @@ type Loaded = (
     tetrefine::io::MeshMeta,
     Option<Vec<bool>>,
     bool,
+    Option<tetrefine::SizeMap>,
 );
 
-/// Rank 0: the input with its features and the selection.
+/// Rank 0: the input with its features, the selection and the size map.
 fn load_on_root(
     a: &Args,
     strategy: Option<&tetrefine::MarkStrategy>,
@@ -306,7 +360,15 @@ fn load_on_root(
     let transfer = super::refine::load_fields(a, &input, &mut meta)?;
     let selection = selection_of(a, strategy, &input)?;
     super::apply_feature_option(&mut input, &a.features, a.feature_angle, a.interfaces)?;
-    Ok(Some((input, meta, selection, transfer)))
+    let size = super::size::size_map(
+        a.size.as_deref(),
+        a.size_array.as_deref(),
+        a.hsiz,
+        a.hmax,
+        &input,
+        &meta,
+    )?;
+    Ok(Some((input, meta, selection, transfer, size)))
 }
 
 /// `OUT_r.vtu` beside `OUT.pvtu` for rank `r`.

@@ -108,6 +108,7 @@ fn request(mesh: &TetMesh) -> Vec<u8> {
         level: ids.iter().map(|&t| mesh.level(t)).collect(),
         parent: ids.iter().map(|&t| mesh.parent(t)).collect(),
         selected: Vec::new(),
+        sizes: None,
     }
     .encode()
 }

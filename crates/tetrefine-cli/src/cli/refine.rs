@@ -298,41 +298,8 @@ pub fn run(a: Args) -> super::CliResult {
     }
     tetrefine::io::Format::for_writing(&a.output).map_err(|e| e.to_string())?;
     super::outputs::refuse_shared_paths(&a.named_outputs())?;
-    let size_given =
-        a.size.is_some() || a.size_array.is_some() || a.hsiz.is_some() || a.hmax.is_some();
-    let n_steps = match (a.steps, size_given) {
-        (Some(super::size::Steps::N(n)), _) => n,
-        (None, false) => 1,
-        (None, true) | (Some(super::size::Steps::Auto), true) => super::size::AUTO_CAP,
-        (Some(super::size::Steps::Auto), false) => {
-            return Err("--steps auto refines until every edge meets a size map: give --size FILE.sol, --size-array NAME, --hsiz H or --hmax H".into())
-        }
-    };
-    let auto = size_given && a.steps.is_none_or(|s| s == super::size::Steps::Auto);
-    if size_given {
-        if let Some(p) = &a.size {
-            super::outputs::refuse_shared_paths(&[
-                ("-o", Some(a.output.as_path())),
-                ("--size", Some(p.as_path())),
-            ])?;
-        }
-        if a.indicator.is_some()
-            || !a.marks.is_empty()
-            || a.region.is_some()
-            || a.select_box.is_some()
-            || a.sphere.is_some()
-        {
-            return Err("a size map chooses what to refine itself: drop --indicator/--mark/--region/--box/--sphere, or the size options".into());
-        }
-        if a.stop_after.is_some() {
-            return Err(
-                "--stop-after names a phase of the √3 step; size-driven refinement has none".into(),
-            );
-        }
-    }
-    if n_steps == 0 && !a.allow_steps_zero {
-        return Err("--steps 0 refines nothing; give --steps N ≥ 1 (or --allow-steps-zero to write the mesh unrefined)".into());
-    }
+    let plan = super::size::plan(&a)?;
+    let (size_given, n_steps, auto) = (plan.size_given, plan.n_steps, plan.auto);
     let budget = super::guard::MemoryBudget::new(a.max_memory.as_deref())?;
     if let Some(h) = &a.histogram {
         super::check_histogram_path(h)?;
@@ -396,7 +363,13 @@ pub fn run(a: Args) -> super::CliResult {
             quality_floor: None,
             // The size loop's optimize phase honours --effort and --hausd
             // as the √3 step's does.
-            improve: a.effort.improve_options(a.opt_passes, a.threshold, a.hausd),
+            improve: tetrefine::size_improve_options(
+                a.effort,
+                a.opt_passes,
+                a.threshold,
+                a.hausd,
+                a.boundary,
+            ),
         };
         let mut last = None;
         for s in 1..=n_steps {
@@ -421,21 +394,7 @@ pub fn run(a: Args) -> super::CliResult {
             }
         }
         if let Some(r) = last {
-            if r.long_after > 0 {
-                let why = if r.split == 0 {
-                    "no split was possible without inverting a tet or falling below the worst quality so far"
-                        .to_string()
-                } else if auto {
-                    format!("--steps auto stops at {n_steps} passes")
-                } else {
-                    format!("--steps {n_steps} passes were run")
-                };
-                eprintln!(
-                    "note: {} edges are still longer than {:.2}× their target: {why}",
-                    r.long_after,
-                    tetrefine::SPLIT_ABOVE
-                );
-            }
+            super::size::note_still_long(r.long_after as u64, r.split == 0, &plan);
         }
     } else {
         let progress = BarProgress::new(n_steps, phases_per_step);

@@ -30,6 +30,82 @@ impl std::str::FromStr for Steps {
     }
 }
 
+/// What `--steps` and the size options ask of `refine`.
+pub struct Plan {
+    /// A size map is given (`--size`, `--size-array`, `--hsiz`, `--hmax`).
+    pub size_given: bool,
+    /// √3 steps, or size passes with a size map.
+    pub n_steps: usize,
+    /// Size passes stop once every edge meets the map (`--steps auto`, the
+    /// default with a size map).
+    pub auto: bool,
+}
+
+/// The plan of `a`, or why its options do not go together.
+pub fn plan(a: &super::refine::Args) -> Result<Plan, String> {
+    let size_given =
+        a.size.is_some() || a.size_array.is_some() || a.hsiz.is_some() || a.hmax.is_some();
+    let n_steps = match (a.steps, size_given) {
+        (Some(Steps::N(n)), _) => n,
+        (None, false) => 1,
+        (None, true) | (Some(Steps::Auto), true) => AUTO_CAP,
+        (Some(Steps::Auto), false) => {
+            return Err("--steps auto refines until every edge meets a size map: give --size FILE.sol, --size-array NAME, --hsiz H or --hmax H".into())
+        }
+    };
+    let auto = size_given && a.steps.is_none_or(|s| s == Steps::Auto);
+    if size_given {
+        if let Some(p) = &a.size {
+            super::outputs::refuse_shared_paths(&[
+                ("-o", Some(a.output.as_path())),
+                ("--size", Some(p.as_path())),
+            ])?;
+        }
+        if a.indicator.is_some()
+            || !a.marks.is_empty()
+            || a.region.is_some()
+            || a.select_box.is_some()
+            || a.sphere.is_some()
+        {
+            return Err("a size map chooses what to refine itself: drop --indicator/--mark/--region/--box/--sphere, or the size options".into());
+        }
+        if a.stop_after.is_some() {
+            return Err(
+                "--stop-after names a phase of the √3 step; size-driven refinement has none".into(),
+            );
+        }
+    }
+    if n_steps == 0 && !a.allow_steps_zero {
+        return Err("--steps 0 refines nothing; give --steps N ≥ 1 (or --allow-steps-zero to write the mesh unrefined)".into());
+    }
+    Ok(Plan {
+        size_given,
+        n_steps,
+        auto,
+    })
+}
+
+/// Tells the user, after the size passes, that `long` edges are still
+/// longer than their target, and why: `stuck` (the last pass split
+/// nothing), or the passes ran out.
+pub fn note_still_long(long: u64, stuck: bool, plan: &Plan) {
+    if long == 0 {
+        return;
+    }
+    let why = if stuck {
+        "no split was possible without inverting a tet or falling below the worst quality so far"
+            .to_string()
+    } else if plan.auto {
+        format!("--steps auto stops at {} passes", plan.n_steps)
+    } else {
+        format!("--steps {} passes were run", plan.n_steps)
+    };
+    eprintln!(
+        "note: {long} edges are still longer than {:.2}× their target: {why}",
+        tetrefine::SPLIT_ABOVE
+    );
+}
+
 /// The size map of the options, over the points of `input`, or `None`
 /// when none is given.
 pub fn size_map(
