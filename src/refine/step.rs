@@ -5,7 +5,7 @@ use crate::improve::{improve, ImproveOptions};
 use crate::mesh::ball_stays_positive;
 use crate::mesh::fasthash::FastHashMap;
 use crate::mesh::partition::{canonical_centroid, partition_edges, PartitionMarker};
-use crate::mesh::{edge_key, TetMarks, TetMesh};
+use crate::mesh::{edge_key, TetMarks, TetMesh, NO_ADJ};
 use crate::ops::{
     flip23_bulk, make_flips_valid, remove_edge, remove_interface_edge, split14_bulk,
     split_boundary_face, split_interface_face, trisect_edge, EdgeRing, FlipBatch,
@@ -566,7 +566,7 @@ fn boundary_flip_phase(
         }
         if is_feature {
             // Every tet holding the edge, over all its fans.
-            tets_of_edge(mesh, a, b, &mut ball, &mut marks);
+            tets_of_edge(mesh, [a, b], Some(t), &mut ball, &mut marks);
             trisect_at_thirds(mesh, st, [a, b], &ball, report);
             continue;
         }
@@ -644,7 +644,7 @@ fn trisect_interior_features(
     edges.sort_unstable();
     let (mut ball, mut marks) = (Vec::new(), TetMarks::default());
     for [a, b] in edges {
-        tets_of_edge(mesh, a, b, &mut ball, &mut marks);
+        tets_of_edge(mesh, [a, b], None, &mut ball, &mut marks);
         let refined = |u: &u32| mesh.tet(*u).iter().any(|&v| v >= st.first_barycentre);
         if ball.is_empty() || !ball.iter().all(refined) {
             report.kept_feature_edges += 1;
@@ -654,10 +654,49 @@ fn trisect_interior_features(
     }
 }
 
-/// Every tet holding the edge `(a, b)`, over all its fans, into `out`.
-fn tets_of_edge(mesh: &TetMesh, a: u32, b: u32, out: &mut Vec<u32>, marks: &mut TetMarks) {
-    mesh.ball_marked(a, out, marks);
-    out.retain(|&u| mesh.tet(u).contains(&b));
+/// Every tet holding the edge `(a, b)`, over all its fans, into `out`: the
+/// tets at `a` or `b` reached across faces at `a` or `b` from `known` (a tet
+/// holding the edge, when the caller has one) and from the tets `a` and `b`
+/// are stored with, kept when they hold both.
+///
+/// The ball of `a` alone, walked from its stored tet, is not enough where
+/// the domain touches itself at `a` (its tets fall into groups that share
+/// no face): the walk stays in one group, which may not hold the edge. A
+/// rank's part touches itself so wherever the cut, once moved, meets
+/// itself at a point, though the union of the parts does not.
+fn tets_of_edge(
+    mesh: &TetMesh,
+    [a, b]: [u32; 2],
+    known: Option<u32>,
+    out: &mut Vec<u32>,
+    marks: &mut TetMarks,
+) {
+    out.clear();
+    marks.begin(mesh.n_tet_slots());
+    for t in [known, mesh.tet_of_vertex(a), mesh.tet_of_vertex(b)]
+        .into_iter()
+        .flatten()
+    {
+        if marks.mark(t) {
+            out.push(t);
+        }
+    }
+    let mut i = 0;
+    while i < out.len() {
+        let (v, adj) = (mesh.tet(out[i]), mesh.adj(out[i]));
+        i += 1;
+        for f in 0..4 {
+            // Face `f` (opposite `v[f]`) holds `a` or `b`.
+            let at_end = [a, b].iter().any(|&x| v[f] != x && v.contains(&x));
+            if at_end && adj[f] != NO_ADJ && marks.mark(adj[f] >> 2) {
+                out.push(adj[f] >> 2);
+            }
+        }
+    }
+    out.retain(|&u| {
+        let v = mesh.tet(u);
+        v.contains(&a) && v.contains(&b)
+    });
 }
 
 /// Trisects the feature edge `[a, b]` (its tets `around`) with new points at

@@ -1382,3 +1382,40 @@ fn pieces_read_per_rank_take_hsiz_and_refuse_a_size_file() {
     );
     assert!(!b.exists());
 }
+
+#[test]
+fn pieces_whose_cut_has_moved_read_per_rank_step_as_the_serial_mesh_with_their_cut_marked() {
+    // Pieces written after the cut move: there the cut can meet itself at
+    // a point, so a rank's part touches itself at a vertex its union does
+    // not, and a feature edge ending there must still be trisected (the
+    // tripod lost two of its 336 edges' trisections on the ranks). The
+    // ladder's own domain touches itself along edges and at a vertex: its
+    // edges' fans lie in separate groups of a vertex's tets, serially too.
+    let dir = tempfile::tempdir().unwrap();
+    let s = |p: &Path| p.to_str().unwrap().to_string();
+    for name in ["meshes/tripod.mesh", "meshes/getfem_ladder.mesh"] {
+        let a = dir.path().join("a.pvtu");
+        mpirun_ok(2, &["refine", name, "-o", &s(&a), "--boundary", "linear"]);
+        let b = dir.path().join("b.pvtu");
+        let stats = dir.path().join("b.json");
+        mpirun_ok(
+            2,
+            &[
+                "refine",
+                &s(&a),
+                "-o",
+                &s(&b),
+                "--boundary",
+                "linear",
+                "--opt-passes",
+                "0",
+                "--step-offset",
+                "1",
+                "--stats",
+                &s(&stats),
+            ],
+        );
+        let got = final_stats(&stats)["tets"].as_u64().unwrap() as usize;
+        assert_eq!(got, serial_on_pieces_with_their_cut(&a, 1), "{name}");
+    }
+}
