@@ -346,7 +346,30 @@ fn counts_equal_the_serial_steps_with_the_same_cut_marked() {
         );
         let (union, _) = union_of_pieces(&out);
         assert_eq!(union.n_tets(), expected);
+        // `marked` as the serial output's: the tet's `parent` (here the
+        // input tet it descends from) was selected; every tet when uniform.
+        let marked = piece_cell_array(&out, "marked");
+        let parent = piece_cell_array(&out, "parent");
+        assert_eq!(marked.len(), expected);
+        for (m, p) in marked.iter().zip(&parent) {
+            let want = select.is_none_or(|s| s[*p as usize]);
+            assert_eq!(*m, f64::from(u8::from(want)), "parent {p}");
+        }
     }
+}
+
+/// Cell array `name` of every piece `pvtu` lists, piece after piece.
+fn piece_cell_array(pvtu: &Path, name: &str) -> Vec<f64> {
+    let text = std::fs::read_to_string(pvtu).unwrap();
+    text.lines()
+        .filter_map(|l| l.trim().strip_prefix("<Piece Source=\""))
+        .map(|l| pvtu.with_file_name(l.trim_end_matches("\"/>")))
+        .flat_map(|piece| {
+            tetrefine::io::read_tet_cell_array(&piece, name)
+                .unwrap_or_else(|e| panic!("{}: {e}", piece.display()))
+                .values
+        })
+        .collect()
 }
 
 #[test]

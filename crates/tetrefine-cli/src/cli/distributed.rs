@@ -245,12 +245,20 @@ pub fn run(a: Args) -> super::CliResult {
         } else {
             None
         };
+        // Rank 0's selection, per input tet, for each piece's `marked`
+        // (empty: uniform, every tet marked).
+        let selected = comm.broadcast(
+            selection
+                .as_deref()
+                .map_or_else(Vec::new, |s| s.iter().map(|&x| u8::from(x)).collect()),
+        );
         write_pieces(
             &comm,
             &a.output,
             a.parent_map.as_deref(),
             &mut local,
             located,
+            &selected,
             &last,
         )
     } else {
@@ -401,8 +409,9 @@ fn rename_clashes(fields: &mut [tetrefine::io::Field], taken: &[&str]) {
     }
 }
 
-/// One `.vtu` per rank (with `GlobalPointIds`, `rank`, `level`, `parent`
-/// and the quality arrays; with `located`, the vertex parent map's arrays
+/// One `.vtu` per rank (with `GlobalPointIds`, `rank`, `level`, `parent`,
+/// `marked` (from `selected`, rank 0's selection per input tet) and the
+/// quality arrays; with `located`, the vertex parent map's arrays
 /// and the input's fields, and `parent` is the input tet holding each
 /// centroid), `MAP_r` for `--parent-map MAP`, and on rank 0 the `.pvtu`
 /// listing the pieces with the same arrays.
@@ -412,6 +421,7 @@ fn write_pieces(
     parent_map: Option<&Path>,
     local: &mut LocalMesh,
     located: Option<Located>,
+    selected: &[u8],
     global: &MeshStats,
 ) -> Result<(), String> {
     let ids = dist::global_point_ids(comm, &local.mesh)?;
@@ -426,9 +436,16 @@ fn write_pieces(
     let level = |i: usize| i32::from(mesh.level(i as u32));
     let parent = |i: usize| mesh.parent(i as u32) as i32;
     let rank_of = |_: usize| rank;
+    // As the serial output's: whether the tet's `parent` was selected
+    // (every tet of a uniform run).
+    let marked = |i: usize| {
+        let p = mesh.parent(i as u32) as usize;
+        i32::from(selected.is_empty() || selected.get(p).is_some_and(|&x| x == 1))
+    };
     let mut cells = vec![
         CellArray::Int32With("level".into(), n, &level),
         CellArray::Int32With("parent".into(), n, &parent),
+        CellArray::Int32With("marked".into(), n, &marked),
         CellArray::Int32With("rank".into(), n, &rank_of),
     ];
     let mut points = vec![PointArray::Int32("GlobalPointIds".into(), 1, gids)];
