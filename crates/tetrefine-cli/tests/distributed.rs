@@ -980,6 +980,33 @@ fn serial_on_pieces_with_their_cut(pvtu: &Path, step_offset: usize) -> usize {
     mesh.n_tets()
 }
 
+/// `pvtu` read per rank on 2 ranks and stepped once (linear, no
+/// optimisation, the second global step) into `dir/b.pvtu`: the reported
+/// tet count and the output's path.
+fn linear_step_on_pieces(pvtu: &Path, dir: &Path) -> (usize, PathBuf) {
+    let s = |p: &Path| p.to_str().unwrap().to_string();
+    let b = dir.join("b.pvtu");
+    let stats = dir.join("b.json");
+    mpirun_ok(
+        2,
+        &[
+            "refine",
+            &s(pvtu),
+            "-o",
+            &s(&b),
+            "--boundary",
+            "linear",
+            "--opt-passes",
+            "0",
+            "--step-offset",
+            "1",
+            "--stats",
+            &s(&stats),
+        ],
+    );
+    (final_stats(&stats)["tets"].as_u64().unwrap() as usize, b)
+}
+
 #[test]
 fn pvtu_pieces_read_per_rank_step_as_the_serial_mesh_with_their_cut_marked() {
     // The pieces METIS made, unrefined (no step, no cut move), read back
@@ -1003,26 +1030,7 @@ fn pvtu_pieces_read_per_rank_step_as_the_serial_mesh_with_their_cut_marked() {
             "optimize",
         ],
     );
-    let b = dir.path().join("b.pvtu");
-    let stats = dir.path().join("b.json");
-    mpirun_ok(
-        2,
-        &[
-            "refine",
-            &s(&a),
-            "-o",
-            &s(&b),
-            "--boundary",
-            "linear",
-            "--opt-passes",
-            "0",
-            "--step-offset",
-            "1",
-            "--stats",
-            &s(&stats),
-        ],
-    );
-    let got = final_stats(&stats)["tets"].as_u64().unwrap() as usize;
+    let (got, b) = linear_step_on_pieces(&a, dir.path());
     assert_eq!(got, serial_on_pieces_with_their_cut(&a, 1));
     let (union, _) = union_of_pieces(&b);
     assert_eq!(union.n_tets(), got);
@@ -1419,26 +1427,7 @@ fn pieces_whose_cut_has_moved_read_per_rank_step_as_the_serial_mesh_with_their_c
     for name in ["meshes/tripod.mesh", "meshes/getfem_ladder.mesh"] {
         let a = dir.path().join("a.pvtu");
         mpirun_ok(2, &["refine", name, "-o", &s(&a), "--boundary", "linear"]);
-        let b = dir.path().join("b.pvtu");
-        let stats = dir.path().join("b.json");
-        mpirun_ok(
-            2,
-            &[
-                "refine",
-                &s(&a),
-                "-o",
-                &s(&b),
-                "--boundary",
-                "linear",
-                "--opt-passes",
-                "0",
-                "--step-offset",
-                "1",
-                "--stats",
-                &s(&stats),
-            ],
-        );
-        let got = final_stats(&stats)["tets"].as_u64().unwrap() as usize;
+        let (got, _) = linear_step_on_pieces(&a, dir.path());
         assert_eq!(got, serial_on_pieces_with_their_cut(&a, 1), "{name}");
     }
 }

@@ -368,14 +368,7 @@ fn load_on_root(
     let transfer = super::refine::load_fields(a, &input, &mut meta)?;
     let selection = selection_of(a, strategy, &input)?;
     super::apply_feature_option(&mut input, &a.features, a.feature_angle, a.interfaces)?;
-    let size = super::size::size_map(
-        a.size.as_deref(),
-        a.size_array.as_deref(),
-        a.hsiz,
-        a.hmax,
-        &input,
-        &meta,
-    )?;
+    let size = super::size::size_map_of(a, &input, &meta)?;
     Ok(Some((input, meta, selection, transfer, size)))
 }
 

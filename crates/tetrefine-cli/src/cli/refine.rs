@@ -322,14 +322,7 @@ pub fn run(a: Args) -> super::CliResult {
         input.n_tets() as u64,
     )?;
     super::apply_feature_option(&mut input, &a.features, a.feature_angle, a.interfaces)?;
-    let size = super::size::size_map(
-        a.size.as_deref(),
-        a.size_array.as_deref(),
-        a.hsiz,
-        a.hmax,
-        &input,
-        &meta,
-    )?;
+    let size = super::size::size_map_of(&a, &input, &meta)?;
     let mut mesh = input.clone();
     let opts = RefineOptions {
         boundary: a.boundary,

@@ -106,6 +106,22 @@ pub fn note_still_long(long: u64, stuck: bool, plan: &Plan) {
     );
 }
 
+/// [`size_map`] of `a`'s size options.
+pub fn size_map_of(
+    a: &super::refine::Args,
+    input: &TetMesh,
+    meta: &MeshMeta,
+) -> Result<Option<SizeMap>, String> {
+    size_map(
+        a.size.as_deref(),
+        a.size_array.as_deref(),
+        a.hsiz,
+        a.hmax,
+        input,
+        meta,
+    )
+}
+
 /// The size map of the options, over the points of `input`, or `None`
 /// when none is given.
 pub fn size_map(
