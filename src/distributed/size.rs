@@ -26,8 +26,8 @@ use crate::improve::ImproveOptions;
 use crate::mesh::partition::PartitionMarker;
 use crate::mesh::TetMesh;
 use crate::refine::size::{
-    size_pass, split_at_midpoint, split_quality, worst_metric_quality, SizeMap, SizeOptions,
-    SPLIT_ABOVE,
+    size_pass, split_at_midpoint, split_quality, without_insertion, worst_metric_quality, SizeMap,
+    SizeOptions, SPLIT_ABOVE,
 };
 use crate::report::MeshStats;
 use crate::topo::{edge_key, TET_EDGES};
@@ -36,15 +36,6 @@ use std::collections::{HashMap, HashSet};
 /// How often the cut moves in a size-driven run, each move followed by
 /// the optimize phase and more passes.
 const SIZE_CUT_MOVES: usize = 2;
-
-/// The size passes' optimize phase without vertex insertion (an inserted
-/// point would have no size; see [`size_pass`]).
-fn improve_only(o: &ImproveOptions) -> ImproveOptions {
-    ImproveOptions {
-        insert_vertices: false,
-        ..o.clone()
-    }
-}
 
 /// Options of [`size_distributed`].
 #[derive(Clone, Debug, Default)]
@@ -107,7 +98,7 @@ pub fn size_distributed(
             // tets were never optimised, and splits judged on them against
             // the floor would be refused (tripod, --hsiz 1.5 on 2 ranks: 102
             // of 102 long edges refused after the move without this).
-            crate::improve::improve(&mut local.mesh, &improve_only(&opts.improve));
+            crate::improve::improve(&mut local.mesh, &without_insertion(&opts.improve));
         }
         for _ in 0..opts.passes {
             pass += 1;

@@ -306,12 +306,19 @@ pub fn size_improve_options(
     hausd: Option<f64>,
     boundary: crate::stencil::Sqrt3Rule,
 ) -> ImproveOptions {
-    let mut io = ImproveOptions {
-        insert_vertices: false,
-        ..effort.improve_options(passes, threshold, hausd)
-    };
+    let mut io = without_insertion(&effort.improve_options(passes, threshold, hausd));
     super::step::keep_domain_for(&mut io, boundary);
     io
+}
+
+/// `o` without vertex insertion: the size passes' optimize phase, whatever
+/// options it is given (an inserted point would need a size, and the map
+/// only gives one to the midpoint of a split it made, `push_mean`).
+pub(crate) fn without_insertion(o: &ImproveOptions) -> ImproveOptions {
+    ImproveOptions {
+        insert_vertices: false,
+        ..o.clone()
+    }
 }
 
 /// The long edges of `mesh`, longest first (ties by vertex ids).
@@ -445,14 +452,7 @@ pub fn size_pass(mesh: &mut TetMesh, size: &mut SizeMap, opts: &SizeOptions) -> 
         }
     }
     if opts.improve.passes > 0 {
-        // No vertex insertion: an inserted point would need a metric, and
-        // the map only knows how to give one to the midpoint of a split
-        // it made (`push_mean`).
-        let io = ImproveOptions {
-            insert_vertices: false,
-            ..opts.improve.clone()
-        };
-        improve(mesh, &io);
+        improve(mesh, &without_insertion(&opts.improve));
     }
     debug_assert_eq!(size.len(), mesh.n_points());
     report.long_after = long_edges(mesh, size).len();

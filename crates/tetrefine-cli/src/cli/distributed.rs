@@ -82,8 +82,8 @@ pub fn run(a: Args) -> super::CliResult {
     let (mut input, meta, selection, transfer, mut local, first_selection) = if pvtu_in {
         // Every rank reads its own pieces; nobody holds the whole input.
         let mut local = super::pvtu_input::load_pieces(&comm, &a)?;
-        local.size =
-            super::size::size_map(None, None, a.hsiz, a.hmax, &local.mesh, &Default::default())?;
+        // --size and --size-array were refused above: --hsiz/--hmax only.
+        local.size = super::size::size_map_of(&a, &local.mesh, &Default::default())?;
         let c = dist::census(&comm, &local.mesh)?;
         let first = dist::global_stats(&comm, &local.mesh, &c)?;
         if root {
@@ -306,13 +306,7 @@ fn size_loop(
     let opts = dist::DistributedSizeOptions {
         passes: plan.n_steps,
         until_met: plan.auto,
-        improve: tetrefine::size_improve_options(
-            a.effort,
-            a.opt_passes,
-            a.threshold,
-            a.hausd,
-            a.boundary,
-        ),
+        improve: super::size::improve_options_of(a),
     };
     let mut said_moves = 0;
     let (census, last, r) = dist::size_distributed(comm, local, &opts, |s, stats, r, secs| {

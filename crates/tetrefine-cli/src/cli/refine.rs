@@ -356,13 +356,7 @@ pub fn run(a: Args) -> super::CliResult {
             quality_floor: None,
             // The size loop's optimize phase honours --effort and --hausd
             // as the √3 step's does.
-            improve: tetrefine::size_improve_options(
-                a.effort,
-                a.opt_passes,
-                a.threshold,
-                a.hausd,
-                a.boundary,
-            ),
+            improve: super::size::improve_options_of(&a),
         };
         let mut last = None;
         for s in 1..=n_steps {

@@ -122,6 +122,12 @@ pub fn size_map_of(
     )
 }
 
+/// The size passes' optimize phase from `a`'s `--effort`, `--opt-passes`,
+/// `--threshold`, `--hausd` and `--boundary`.
+pub fn improve_options_of(a: &super::refine::Args) -> tetrefine::ImproveOptions {
+    tetrefine::size_improve_options(a.effort, a.opt_passes, a.threshold, a.hausd, a.boundary)
+}
+
 /// The size map of the options, over the points of `input`, or `None`
 /// when none is given.
 pub fn size_map(
