@@ -60,7 +60,9 @@ pub mod tetgen;
 pub mod topo;
 
 pub use file::IoError;
-pub use improve::{improve, BoundarySmoothOptions, Effort, ImproveOptions, ImproveReport};
+pub use improve::{
+    improve, BoundarySmoothOptions, Effort, ImproveOptions, ImproveReport, DEFAULT_THRESHOLD,
+};
 pub use io::{load_mesh, read_mesh, write_mesh};
 pub use mesh::generate::cube_grid;
 pub use mesh::partition::{

@@ -16,7 +16,8 @@ pub const LONG_EDGE_FACTOR: f64 = 1.4;
 /// How hard mesh improvement works.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Effort {
-    /// Interior moves and edge removal only (the boundary stays fixed): the
+    /// Interior moves and edge removal only (the boundary stays fixed), a
+    /// Laplacian move kept only where it raises its ball's worst tet: the
     /// behaviour before boundary-aware improvement.
     Fast,
     /// Interior and boundary moves (surface patches, feature lines).
@@ -45,6 +46,7 @@ impl Effort {
         match self {
             Effort::Fast => ImproveOptions {
                 boundary: None,
+                smooth_for_mean: false,
                 ..base
             },
             Effort::Default => ImproveOptions {

@@ -16,7 +16,7 @@ pub mod ring;
 
 pub use boundary_smooth::BoundarySmoothOptions;
 pub use effort::Effort;
-pub use passes::{improve, ImproveOptions, ImproveReport};
+pub use passes::{improve, ImproveOptions, ImproveReport, DEFAULT_THRESHOLD};
 
 use crate::geom::{all_positive, tet_min_sine};
 use crate::mesh::TetMesh;

@@ -190,7 +190,7 @@ impl Default for RefineOptions {
         RefineOptions {
             boundary: Sqrt3Rule::Interpolating,
             opt_passes: 3,
-            threshold: 0.3,
+            threshold: crate::improve::DEFAULT_THRESHOLD,
             stop_after: None,
             selection: None,
             smooth_refined_only: false,

@@ -62,7 +62,7 @@ pub struct Args {
     #[arg(long, default_value_t = 3)]
     pub opt_passes: usize,
     /// Minimum-sine quality below which vertices get optimization-based smoothing.
-    #[arg(long, default_value_t = 0.3)]
+    #[arg(long, default_value_t = tetrefine::DEFAULT_THRESHOLD)]
     pub threshold: f64,
     /// How hard the optimize phase works: fast (boundary fixed), default
     /// (boundary vertices move inside their patch and along feature lines),
