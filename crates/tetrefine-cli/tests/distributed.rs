@@ -1101,28 +1101,7 @@ fn a_bad_pvtu_piece_ends_every_rank_naming_the_file() {
     let pieces = piece_sources(&a);
     let out = dir.path().join("o.pvtu");
     let fails = |ranks: u32, what: &str, expect: &[&str]| {
-        let o = Command::new("timeout")
-            .args([
-                "300",
-                "mpirun",
-                "--allow-run-as-root",
-                "--oversubscribe",
-                "-n",
-            ])
-            .arg(ranks.to_string())
-            .arg(env!("CARGO_BIN_EXE_tetrefine"))
-            .args(["refine", &s(&a), "-o", &s(&out)])
-            .current_dir(support::root())
-            .output()
-            .unwrap();
-        assert_ne!(o.status.code(), Some(124), "{what}: the job hung");
-        assert!(!o.status.success(), "{what}");
-        let err = String::from_utf8_lossy(&o.stderr);
-        for e in expect {
-            assert!(err.contains(e), "{what}: {err}");
-        }
-        assert!(!out.exists(), "{what}");
-        assert!(!piece_sources_exist(&out), "{what}");
+        fails_without_output(ranks, &a, &out, what, expect);
     };
     // Fewer pieces than ranks.
     fails(3, "3 ranks", &["a.pvtu", "2 pieces for 3 ranks"]);
@@ -1159,10 +1138,159 @@ fn a_bad_pvtu_piece_ends_every_rank_naming_the_file() {
     fails(2, "missing", &["a_1.vtu"]);
 }
 
+/// `mpirun -n ranks tetrefine refine PVTU -o OUT` fails (under a timeout:
+/// no hang) with every string of `expect` in its stderr, and leaves neither
+/// `OUT` nor any piece of it.
+fn fails_without_output(ranks: u32, pvtu: &Path, out: &Path, what: &str, expect: &[&str]) {
+    let o = Command::new("timeout")
+        .args([
+            "300",
+            "mpirun",
+            "--allow-run-as-root",
+            "--oversubscribe",
+            "-n",
+        ])
+        .arg(ranks.to_string())
+        .arg(env!("CARGO_BIN_EXE_tetrefine"))
+        .arg("refine")
+        .arg(pvtu)
+        .arg("-o")
+        .arg(out)
+        .current_dir(support::root())
+        .output()
+        .unwrap();
+    assert_ne!(o.status.code(), Some(124), "{what}: the job hung");
+    assert!(!o.status.success(), "{what}");
+    let err = String::from_utf8_lossy(&o.stderr);
+    for e in expect {
+        assert!(err.contains(e), "{what}: {err}");
+    }
+    assert!(!err.contains("panicked"), "{what}: {err}");
+    assert!(!out.exists(), "{what}");
+    assert!(!piece_sources_exist(out), "{what}");
+}
+
+/// Writes an ASCII `.vtu` of its own (not the code under test's writer):
+/// `points`, the tetrahedra `tets` (0-based, any orientation) and the point
+/// array `GlobalPointIds`.
+fn write_ascii_vtu(path: &Path, points: &[[f64; 3]], tets: &[[u32; 4]], gids: &[i64]) {
+    let join = |it: &mut dyn Iterator<Item = String>| it.collect::<Vec<_>>().join(" ");
+    let xml = format!(
+        r#"<?xml version="1.0"?>
+<VTKFile type="UnstructuredGrid" version="1.0" byte_order="LittleEndian" header_type="UInt64">
+  <UnstructuredGrid>
+    <Piece NumberOfPoints="{np}" NumberOfCells="{nc}">
+      <PointData>
+        <DataArray type="Int64" Name="GlobalPointIds" format="ascii">{gids}</DataArray>
+      </PointData>
+      <Points>
+        <DataArray type="Float64" NumberOfComponents="3" format="ascii">{pts}</DataArray>
+      </Points>
+      <Cells>
+        <DataArray type="Int64" Name="connectivity" format="ascii">{conn}</DataArray>
+        <DataArray type="Int64" Name="offsets" format="ascii">{offs}</DataArray>
+        <DataArray type="UInt8" Name="types" format="ascii">{types}</DataArray>
+      </Cells>
+    </Piece>
+  </UnstructuredGrid>
+</VTKFile>
+"#,
+        np = points.len(),
+        nc = tets.len(),
+        gids = join(&mut gids.iter().map(|g| g.to_string())),
+        // `{}` writes the shortest text that reads back to the same f64.
+        pts = join(&mut points.iter().flatten().map(|x| x.to_string())),
+        conn = join(&mut tets.iter().flatten().map(|v| v.to_string())),
+        offs = join(&mut (1..=tets.len()).map(|i| (4 * i).to_string())),
+        types = join(&mut tets.iter().map(|_| "10".to_string())),
+    );
+    std::fs::write(path, xml).unwrap();
+}
+
 /// Whether any piece `OUT_r.vtu` of `out` exists.
 fn piece_sources_exist(out: &Path) -> bool {
     let stem = out.file_stem().unwrap().to_string_lossy().into_owned();
     (0..4).any(|r| out.with_file_name(format!("{stem}_{r}.vtu")).exists())
+}
+
+#[test]
+fn an_inverted_or_degenerate_tet_in_a_piece_ends_every_rank_naming_the_piece_and_the_tet() {
+    // Pieces written on two ranks; then piece 1 rewritten by the test's own
+    // XML with one tet corrupted: two of its point indices swapped
+    // (inverted), a point repeated, or its last point replaced by a new
+    // point at the coordinates of its second (four distinct indices, zero
+    // volume). Read per rank (2 ranks) and by one rank reading both: every
+    // rank ends, the message names the piece and the tet, no file is left.
+    let dir = tempfile::tempdir().unwrap();
+    let s = |p: &Path| p.to_str().unwrap().to_string();
+    let a = dir.path().join("a.pvtu");
+    mpirun_ok(
+        2,
+        &[
+            "refine",
+            "meshes/tripod.mesh",
+            "-o",
+            &s(&a),
+            "--boundary",
+            "linear",
+        ],
+    );
+    let pieces = piece_sources(&a);
+    let (d, meta) = tetrefine::io::read_mesh_with_meta(&pieces[1]).unwrap();
+    let gids: Vec<i64> = meta
+        .point_fields
+        .iter()
+        .find(|f| f.name == "GlobalPointIds")
+        .unwrap()
+        .values
+        .iter()
+        .map(|&g| g as i64)
+        .collect();
+    // The file as read, rewritten unchanged, is accepted (the test's writer
+    // is sound): the corruption alone makes the runs below fail.
+    write_ascii_vtu(&pieces[1], &d.points, &d.tets, &gids);
+    let ok = dir.path().join("ok.pvtu");
+    mpirun_ok(
+        2,
+        &[
+            "refine",
+            &s(&a),
+            "-o",
+            &s(&ok),
+            "--steps",
+            "0",
+            "--allow-steps-zero",
+        ],
+    );
+    let k = d.tets.len() / 2;
+    let out = dir.path().join("o.pvtu");
+    let tet = format!("tetrahedron {}", k + 1);
+    let piece = pieces[1].file_name().unwrap().to_str().unwrap();
+    let mut t = d.tets.clone();
+    t[k].swap(0, 1);
+    write_ascii_vtu(&pieces[1], &d.points, &t, &gids);
+    for ranks in [2, 1] {
+        let what = format!("inverted, -n {ranks}");
+        fails_without_output(ranks, &a, &out, &what, &[piece, &tet, "inverted"]);
+    }
+    let mut t = d.tets.clone();
+    t[k][3] = t[k][0];
+    write_ascii_vtu(&pieces[1], &d.points, &t, &gids);
+    for ranks in [2, 1] {
+        let what = format!("a repeated point, -n {ranks}");
+        fails_without_output(ranks, &a, &out, &what, &[piece, &tet, "degenerate"]);
+    }
+    let mut t = d.tets.clone();
+    let mut points = d.points.clone();
+    points.push(d.points[t[k][1] as usize]);
+    t[k][3] = (points.len() - 1) as u32;
+    let mut ids = gids.clone();
+    ids.push(i64::from(i32::MAX));
+    write_ascii_vtu(&pieces[1], &points, &t, &ids);
+    for ranks in [2, 1] {
+        let what = format!("coplanar points, -n {ranks}");
+        fails_without_output(ranks, &a, &out, &what, &[piece, &tet, "degenerate"]);
+    }
 }
 
 /// A `.pvtu` written on two ranks has had one step (its pieces' `level`):

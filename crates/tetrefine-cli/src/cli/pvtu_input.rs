@@ -31,7 +31,7 @@ pub fn per_rank(a: &Args) -> bool {
 }
 
 /// Every rank's share of the `.pvtu` input `a.input`, with its cut faces
-/// marked. A collective: a bad piece (missing, corrupt, an inverted tet,
+/// marked. A collective: a bad piece (missing, corrupt, an inverted or degenerate tet,
 /// `GlobalPointIds` that disagree) ends every rank with an error naming
 /// the file.
 pub fn load_pieces(comm: &Comm, a: &Args) -> Result<LocalMesh, String> {

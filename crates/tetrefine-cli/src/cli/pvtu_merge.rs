@@ -102,6 +102,44 @@ impl FieldMerge {
     }
 }
 
+/// Every tet of the piece at `path` (read as `d`) has four distinct points
+/// and a positive volume (the exact orientation test the mesh builder
+/// uses). A piece is written oriented: an inverted or degenerate tet is a
+/// corrupt piece, named with the tet's number (1-based, in the piece's own
+/// order), its points (0-based, as a one-piece `.vtu`'s connectivity has them) and
+/// the line of the connectivity. Checked piece by piece, before the points
+/// of several pieces are joined (which would renumber them).
+fn check_tets(path: &std::path::Path, d: &MeshData) -> Result<(), String> {
+    use tetrefine::geom::{orient3d_sign, Orientation};
+    for (t, v) in d.tets.iter().enumerate() {
+        let distinct = (0..4).all(|i| (i + 1..4).all(|j| v[i] != v[j]));
+        let problem = if distinct {
+            let q = v.map(|x| glam::DVec3::from_array(d.points[x as usize]));
+            match orient3d_sign(q[0], q[1], q[2], q[3]) {
+                Orientation::Positive => continue,
+                Orientation::Negative => "is inverted (negative volume)",
+                Orientation::Zero => "is degenerate (zero volume: its four points are coplanar)",
+            }
+        } else {
+            "is degenerate (it repeats a point)"
+        };
+        let line = d
+            .tet_lines
+            .get(t)
+            .map_or_else(String::new, |l| format!(", connectivity at line {l}"));
+        return Err(format!(
+            "{}: tetrahedron {} (points {} {} {} {}{line}) {problem}: a corrupt piece",
+            path.display(),
+            t + 1,
+            v[0],
+            v[1],
+            v[2],
+            v[3]
+        ));
+    }
+    Ok(())
+}
+
 /// Per merged point: its `GlobalPointIds` value (when the pieces carry
 /// them) and the index of the piece it was first read from.
 pub type PointIds = Vec<(Option<u64>, usize)>;
@@ -109,7 +147,7 @@ pub type PointIds = Vec<(Option<u64>, usize)>;
 /// This rank's pieces as one mesh: points shared by `GlobalPointIds` when
 /// every piece has them (and by exact coordinates: equal coordinates are
 /// one point), else by exact coordinates alone. A piece that cannot be
-/// read, holds an inverted tet, or gives one id to two points is an error
+/// read, holds an inverted or degenerate tet, or gives one id to two points is an error
 /// naming it.
 pub fn merge_pieces(
     pieces: &[(usize, &PathBuf)],
@@ -142,16 +180,7 @@ pub fn merge_pieces(
             }
             None => None,
         };
-        if let Some(t) = d.tets.iter().position(|t| {
-            let q = t.map(|v| glam::DVec3::from_array(d.points[v as usize]));
-            tetrefine::geom::tet_volume(&q) < 0.0
-        }) {
-            return Err(format!(
-                "{}: tetrahedron {} is inverted (negative volume): a corrupt piece",
-                path.display(),
-                t + 1
-            ));
-        }
+        check_tets(path, &d)?;
         read.push((i, path, d, gids, meta));
     }
     let by_id = read.iter().all(|r| r.3.is_some());
