@@ -1101,7 +1101,7 @@ fn a_bad_pvtu_piece_ends_every_rank_naming_the_file() {
     let pieces = piece_sources(&a);
     let out = dir.path().join("o.pvtu");
     let fails = |ranks: u32, what: &str, expect: &[&str]| {
-        fails_without_output(ranks, &a, &out, what, expect);
+        fails_without_output(ranks, &a, &out, &[], what, expect);
     };
     // Fewer pieces than ranks.
     fails(3, "3 ranks", &["a.pvtu", "2 pieces for 3 ranks"]);
@@ -1138,10 +1138,17 @@ fn a_bad_pvtu_piece_ends_every_rank_naming_the_file() {
     fails(2, "missing", &["a_1.vtu"]);
 }
 
-/// `mpirun -n ranks tetrefine refine PVTU -o OUT` fails (under a timeout:
-/// no hang) with every string of `expect` in its stderr, and leaves neither
-/// `OUT` nor any piece of it.
-fn fails_without_output(ranks: u32, pvtu: &Path, out: &Path, what: &str, expect: &[&str]) {
+/// `mpirun -n ranks tetrefine refine PVTU -o OUT EXTRA…` fails (under a
+/// timeout: no hang) with every string of `expect` in its stderr, and
+/// leaves neither `OUT` nor any piece of it.
+fn fails_without_output(
+    ranks: u32,
+    pvtu: &Path,
+    out: &Path,
+    extra: &[&str],
+    what: &str,
+    expect: &[&str],
+) {
     let o = Command::new("timeout")
         .args([
             "300",
@@ -1156,6 +1163,7 @@ fn fails_without_output(ranks: u32, pvtu: &Path, out: &Path, what: &str, expect:
         .arg(pvtu)
         .arg("-o")
         .arg(out)
+        .args(extra)
         .current_dir(support::root())
         .output()
         .unwrap();
@@ -1171,10 +1179,36 @@ fn fails_without_output(ranks: u32, pvtu: &Path, out: &Path, what: &str, expect:
 }
 
 /// Writes an ASCII `.vtu` of its own (not the code under test's writer):
-/// `points`, the tetrahedra `tets` (0-based, any orientation) and the point
-/// array `GlobalPointIds`.
-fn write_ascii_vtu(path: &Path, points: &[[f64; 3]], tets: &[[u32; 4]], gids: &[i64]) {
+/// `points`, the tetrahedra `tets` (0-based, any orientation), the point
+/// array `GlobalPointIds`, the cell array `region` (unless `regions` is
+/// empty) and the point arrays `arrays` (name, components, values; their
+/// count is not checked: a wrong one is written as given).
+fn write_ascii_vtu(
+    path: &Path,
+    points: &[[f64; 3]],
+    tets: &[[u32; 4]],
+    gids: &[i64],
+    regions: &[i32],
+    arrays: &[(&str, usize, &[f64])],
+) {
     let join = |it: &mut dyn Iterator<Item = String>| it.collect::<Vec<_>>().join(" ");
+    let extra: String = arrays
+        .iter()
+        .map(|(name, c, v)| {
+            format!(
+                "        <DataArray type=\"Float64\" Name=\"{name}\" NumberOfComponents=\"{c}\" format=\"ascii\">{}</DataArray>\n",
+                join(&mut v.iter().map(|x| x.to_string()))
+            )
+        })
+        .collect();
+    let cell_data = if regions.is_empty() {
+        String::new()
+    } else {
+        format!(
+            "      <CellData>\n        <DataArray type=\"Int32\" Name=\"region\" format=\"ascii\">{}</DataArray>\n      </CellData>\n",
+            join(&mut regions.iter().map(|r| r.to_string()))
+        )
+    };
     let xml = format!(
         r#"<?xml version="1.0"?>
 <VTKFile type="UnstructuredGrid" version="1.0" byte_order="LittleEndian" header_type="UInt64">
@@ -1182,7 +1216,8 @@ fn write_ascii_vtu(path: &Path, points: &[[f64; 3]], tets: &[[u32; 4]], gids: &[
     <Piece NumberOfPoints="{np}" NumberOfCells="{nc}">
       <PointData>
         <DataArray type="Int64" Name="GlobalPointIds" format="ascii">{gids}</DataArray>
-      </PointData>
+{extra}      </PointData>
+{cell_data}
       <Points>
         <DataArray type="Float64" NumberOfComponents="3" format="ascii">{pts}</DataArray>
       </Points>
@@ -1248,7 +1283,7 @@ fn an_inverted_or_degenerate_tet_in_a_piece_ends_every_rank_naming_the_piece_and
         .collect();
     // The file as read, rewritten unchanged, is accepted (the test's writer
     // is sound): the corruption alone makes the runs below fail.
-    write_ascii_vtu(&pieces[1], &d.points, &d.tets, &gids);
+    write_ascii_vtu(&pieces[1], &d.points, &d.tets, &gids, &[], &[]);
     let ok = dir.path().join("ok.pvtu");
     mpirun_ok(
         2,
@@ -1268,17 +1303,17 @@ fn an_inverted_or_degenerate_tet_in_a_piece_ends_every_rank_naming_the_piece_and
     let piece = pieces[1].file_name().unwrap().to_str().unwrap();
     let mut t = d.tets.clone();
     t[k].swap(0, 1);
-    write_ascii_vtu(&pieces[1], &d.points, &t, &gids);
+    write_ascii_vtu(&pieces[1], &d.points, &t, &gids, &[], &[]);
     for ranks in [2, 1] {
         let what = format!("inverted, -n {ranks}");
-        fails_without_output(ranks, &a, &out, &what, &[piece, &tet, "inverted"]);
+        fails_without_output(ranks, &a, &out, &[], &what, &[piece, &tet, "inverted"]);
     }
     let mut t = d.tets.clone();
     t[k][3] = t[k][0];
-    write_ascii_vtu(&pieces[1], &d.points, &t, &gids);
+    write_ascii_vtu(&pieces[1], &d.points, &t, &gids, &[], &[]);
     for ranks in [2, 1] {
         let what = format!("a repeated point, -n {ranks}");
-        fails_without_output(ranks, &a, &out, &what, &[piece, &tet, "degenerate"]);
+        fails_without_output(ranks, &a, &out, &[], &what, &[piece, &tet, "degenerate"]);
     }
     let mut t = d.tets.clone();
     let mut points = d.points.clone();
@@ -1286,10 +1321,10 @@ fn an_inverted_or_degenerate_tet_in_a_piece_ends_every_rank_naming_the_piece_and
     t[k][3] = (points.len() - 1) as u32;
     let mut ids = gids.clone();
     ids.push(i64::from(i32::MAX));
-    write_ascii_vtu(&pieces[1], &points, &t, &ids);
+    write_ascii_vtu(&pieces[1], &points, &t, &ids, &[], &[]);
     for ranks in [2, 1] {
         let what = format!("coplanar points, -n {ranks}");
-        fails_without_output(ranks, &a, &out, &what, &[piece, &tet, "degenerate"]);
+        fails_without_output(ranks, &a, &out, &[], &what, &[piece, &tet, "degenerate"]);
     }
 }
 
@@ -1508,28 +1543,16 @@ fn pieces_read_per_rank_take_hsiz_and_refuse_a_size_file() {
     let (off_cut, on_cut) = still_long(&String::from_utf8_lossy(&o.stderr));
     let (union, _) = union_of_pieces(&sized);
     assert_measures_kept("--hsiz per rank", &union, &vol_in, area_in);
-    let mut long = std::collections::HashSet::new();
-    for t in union.tet_ids() {
-        let v = union.tet(t);
-        for i in 0..4 {
-            for j in i + 1..4 {
-                let (p, q) = (union.point(v[i]), union.point(v[j]));
-                if (q - p).length() / 1.5 > std::f64::consts::SQRT_2 {
-                    long.insert((v[i].min(v[j]), v[i].max(v[j])));
-                }
-            }
-        }
-    }
-    assert_eq!(long.len(), off_cut + on_cut);
+    let long = edges_longer_than(&union, 1.5);
+    assert_eq!(long, off_cut + on_cut);
     let serial_out = dir.path().join("serial.vtu");
     let serial_args = args(&serial_out);
     let o = serial_ok(&serial_args.iter().map(String::as_str).collect::<Vec<_>>());
     let (serial_long, _) = still_long(&String::from_utf8_lossy(&o.stderr));
     assert!(serial_long > 0);
     assert!(
-        long.len() <= serial_long + serial_long / 4,
-        "{} edges still long on 2 ranks, {serial_long} serially",
-        long.len()
+        long <= serial_long + serial_long / 4,
+        "{long} edges still long on 2 ranks, {serial_long} serially"
     );
     let b = dir.path().join("b.pvtu");
     let o = mpirun(2, &["refine", &s(&a), "-o", &s(&b), "--size", "h.sol"]);
@@ -1540,6 +1563,173 @@ fn pieces_read_per_rank_take_hsiz_and_refuse_a_size_file() {
         "{err}"
     );
     assert!(!b.exists());
+}
+
+/// The edges of `mesh` longer than √2 times `h` (each once).
+fn edges_longer_than(mesh: &TetMesh, h: f64) -> usize {
+    let mut long = std::collections::HashSet::new();
+    for t in mesh.tet_ids() {
+        let v = mesh.tet(t);
+        for i in 0..4 {
+            for j in i + 1..4 {
+                let (p, q) = (mesh.point(v[i]), mesh.point(v[j]));
+                if (q - p).length() / h > std::f64::consts::SQRT_2 {
+                    long.insert((v[i].min(v[j]), v[i].max(v[j])));
+                }
+            }
+        }
+    }
+    long.len()
+}
+
+#[test]
+fn pieces_read_per_rank_take_a_size_array_from_their_point_data() {
+    // Pieces written on two ranks, rewritten by the test's own XML with a
+    // point array h = 1.5 at every point: read per rank with --size-array h
+    // they refine as with --hsiz 1.5 (the same tets, the same edges left
+    // long), keep the input's volumes, and report as still long exactly the
+    // union's edges longer than √2 times 1.5. A piece without the array,
+    // with a value ≤ 0, NaN, or one value too few, ends every rank naming
+    // the piece, with no output; so do lengths on one rank and a metric on
+    // the other (naming the .pvtu).
+    let dir = tempfile::tempdir().unwrap();
+    let s = |p: &Path| p.to_str().unwrap().to_string();
+    let a = dir.path().join("a.pvtu");
+    mpirun_ok(
+        2,
+        &[
+            "refine",
+            "meshes/tripod.mesh",
+            "-o",
+            &s(&a),
+            "--boundary",
+            "linear",
+        ],
+    );
+    let (vol_in, area_in) = measures(&input("meshes/tripod.mesh"));
+    let pieces = piece_sources(&a);
+    let read: Vec<_> = pieces
+        .iter()
+        .map(|p| {
+            let (d, meta) = tetrefine::io::read_mesh_with_meta(p).unwrap();
+            let gids: Vec<i64> = meta
+                .point_fields
+                .iter()
+                .find(|f| f.name == "GlobalPointIds")
+                .unwrap()
+                .values
+                .iter()
+                .map(|&g| g as i64)
+                .collect();
+            let regions: Vec<i32> = (0..d.tets.len()).map(|t| d.region(t)).collect();
+            (d, gids, regions)
+        })
+        .collect();
+    let write = |k: usize, h: &[f64]| {
+        let (d, gids, regions) = &read[k];
+        write_ascii_vtu(
+            &pieces[k],
+            &d.points,
+            &d.tets,
+            gids,
+            regions,
+            &[("h", 1, h)],
+        );
+    };
+    let constant = |k: usize| vec![1.5; read[k].0.points.len()];
+    for k in 0..pieces.len() {
+        write(k, &constant(k));
+    }
+    let run = |out: &Path, size: &[&str]| {
+        let mut args = vec!["refine", a.to_str().unwrap(), "-o", out.to_str().unwrap()];
+        args.extend(["--boundary", "linear"]);
+        args.extend(size);
+        let o = mpirun_ok(2, &args);
+        let err = String::from_utf8_lossy(&o.stderr).into_owned();
+        let (union, _) = union_of_pieces(out);
+        (union, still_long(&err))
+    };
+    let (by_array, long_array) = run(&dir.path().join("arr.pvtu"), &["--size-array", "h"]);
+    // The pieces' array is a field to --hsiz, which it would refuse.
+    let (by_hsiz, long_hsiz) = run(
+        &dir.path().join("hsiz.pvtu"),
+        &["--hsiz", "1.5", "--no-transfer"],
+    );
+    assert_measures_kept("--size-array per rank", &by_array, &vol_in, area_in);
+    let long = edges_longer_than(&by_array, 1.5);
+    assert!(long > 0);
+    assert_eq!(long, long_array.0 + long_array.1);
+    assert!(by_array.n_tets() > 4 * input("meshes/tripod.mesh").n_tets());
+    assert_eq!(by_array.n_tets(), by_hsiz.n_tets());
+    assert_eq!(by_array.n_points(), by_hsiz.n_points());
+    assert_eq!(long_array, long_hsiz);
+    assert_eq!(edges_longer_than(&by_hsiz, 1.5), long);
+    // Bad arrays, each in piece 1 (rank 1's).
+    let out = dir.path().join("o.pvtu");
+    let piece = pieces[1].file_name().unwrap().to_str().unwrap();
+    let size = ["--size-array", "h"];
+    fails_without_output(
+        2,
+        &a,
+        &out,
+        &["--size-array", "nope"],
+        "missing",
+        &[
+            pieces[0].file_name().unwrap().to_str().unwrap(),
+            "no point array",
+        ],
+    );
+    let (d, gids, regions) = &read[1];
+    write_ascii_vtu(&pieces[1], &d.points, &d.tets, gids, regions, &[]);
+    fails_without_output(
+        2,
+        &a,
+        &out,
+        &size,
+        "missing in one",
+        &[piece, "no point array"],
+    );
+    let n = d.points.len();
+    let mut h = constant(1);
+    h[n / 2] = 0.0;
+    write(1, &h);
+    let point = format!("point {}", n / 2 + 1);
+    fails_without_output(
+        2,
+        &a,
+        &out,
+        &size,
+        "zero",
+        &[piece, "--size-array h", &point],
+    );
+    h[n / 2] = -1.5;
+    write(1, &h);
+    fails_without_output(2, &a, &out, &size, "negative", &[piece, &point]);
+    h[n / 2] = f64::NAN;
+    write(1, &h);
+    fails_without_output(2, &a, &out, &size, "NaN", &[piece, "not a finite number"]);
+    write(1, &constant(1)[1..]);
+    fails_without_output(2, &a, &out, &size, "too short", &[piece, "values"]);
+    // A metric (6 components, 1/h² on the diagonal) on rank 1, lengths on
+    // rank 0: the map's points travel between ranks, so both must agree.
+    let m = 1.0 / (1.5 * 1.5);
+    let metric: Vec<f64> = (0..n).flat_map(|_| [m, 0.0, m, 0.0, 0.0, m]).collect();
+    write_ascii_vtu(
+        &pieces[1],
+        &d.points,
+        &d.tets,
+        gids,
+        regions,
+        &[("h", 6, &metric)],
+    );
+    fails_without_output(
+        2,
+        &a,
+        &out,
+        &size,
+        "a metric on one rank",
+        &["a.pvtu", "different numbers of components"],
+    );
 }
 
 #[test]

@@ -33,7 +33,7 @@ pub fn names(pieces: &[(usize, &PathBuf)]) -> String {
 pub fn read_pvtu(path: &std::path::Path) -> Result<(MeshData, MeshMeta), String> {
     let all = tetrefine::io::read_pvtu_pieces(path).map_err(|e| e.to_string())?;
     let pieces: Vec<(usize, &PathBuf)> = all.iter().enumerate().collect();
-    let (data, _, meta) = merge_pieces(&pieces)?;
+    let (data, _, meta) = merge_pieces(&pieces, None)?;
     Ok((data, meta))
 }
 
@@ -140,6 +140,48 @@ fn check_tets(path: &std::path::Path, d: &MeshData) -> Result<(), String> {
     Ok(())
 }
 
+/// The point array `name` of the piece at `path` (read as `d` with `meta`)
+/// is a size map: there, 1 (a length) or 6 (a metric) components, one entry
+/// per point, each a positive finite length or a positive-definite metric.
+/// Returns its number of components; an error names the piece, the array
+/// and the problem (for a bad value, the point, 1-based in the piece).
+pub fn check_size_array(
+    path: &std::path::Path,
+    d: &MeshData,
+    meta: &MeshMeta,
+    name: &str,
+) -> Result<usize, String> {
+    let f =
+        meta.point_fields
+            .iter()
+            .find(|f| f.name == name)
+            .ok_or_else(|| {
+                let names: Vec<&str> = meta
+                    .point_fields
+                    .iter()
+                    .map(|f| f.name.as_str())
+                    .filter(|n| !RUN_POINT_ARRAYS.contains(n))
+                    .collect();
+                format!(
+                "{}: --size-array {name}: the piece has no point array of that name (it has: {})",
+                path.display(),
+                if names.is_empty() { "none".to_string() } else { names.join(", ") }
+            )
+            })?;
+    let n = d.points.len();
+    if f.values.len() != n * f.components {
+        return Err(format!(
+            "{}: --size-array {name}: {} values for {n} points of {} components",
+            path.display(),
+            f.values.len(),
+            f.components
+        ));
+    }
+    tetrefine::SizeMap::from_values(f.components, &f.values)
+        .map_err(|e| format!("{}: --size-array {name}: {e}", path.display()))?;
+    Ok(f.components)
+}
+
 /// Per merged point: its `GlobalPointIds` value (when the pieces carry
 /// them) and the index of the piece it was first read from.
 pub type PointIds = Vec<(Option<u64>, usize)>;
@@ -148,13 +190,31 @@ pub type PointIds = Vec<(Option<u64>, usize)>;
 /// every piece has them (and by exact coordinates: equal coordinates are
 /// one point), else by exact coordinates alone. A piece that cannot be
 /// read, holds an inverted or degenerate tet, or gives one id to two points is an error
-/// naming it.
+/// naming it. With `size_array` (`--size-array NAME`), every piece must
+/// carry the point array NAME as a size map (see [`check_size_array`]),
+/// with one number of components in all of them.
 pub fn merge_pieces(
     pieces: &[(usize, &PathBuf)],
+    size_array: Option<&str>,
 ) -> Result<(MeshData, PointIds, MeshMeta), String> {
     let mut read = Vec::with_capacity(pieces.len());
+    let mut size_components: Option<(usize, &PathBuf)> = None;
     for &(i, path) in pieces {
         let (d, meta) = tetrefine::io::read_mesh_with_meta(path).map_err(|e| e.to_string())?;
+        if let Some(name) = size_array {
+            let c = check_size_array(path, &d, &meta, name)?;
+            match size_components {
+                Some((c0, first)) if c0 != c => {
+                    return Err(format!(
+                        "{}: --size-array {name} has {c} components here and {c0} in {}",
+                        path.display(),
+                        first.display()
+                    ))
+                }
+                Some(_) => {}
+                None => size_components = Some((c, path)),
+            }
+        }
         let gids = match meta
             .point_fields
             .iter()
