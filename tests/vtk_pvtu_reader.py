@@ -7,7 +7,8 @@ domain), the arrays region, quality, rank and GlobalPointIds are there, the
 rank count P is the number of pieces VTK finds in the .pvtu, the ranks are
 0 .. P-1, each piece (read alone by VTK's serial reader, in the .pvtu's
 order) is non-empty and holds rank r's tets only, and the global ids
-number the points of the union densely (0 .. n-1, a point on the cut once). When the pieces carry the
+number the points of the union densely (0 .. n-1, a point on the cut once,
+one id per distinct coordinates). When the pieces carry the
 vertex parent map (a run with --parent-map, --fields or --transfer), every
 point is its parent_bary combination of the parent_vertices of the input as
 VTK reads it.
@@ -74,6 +75,12 @@ def main(pvtu, original):
     assert unique == list(range(len(unique))), "global ids are not 0..n-1"
     # Points on the cut appear once per piece holding them.
     assert len(g) > len(unique), (len(g), len(unique))
+    # One id per distinct point of the union, and one point per id.
+    ids_at = {}
+    for p, i in zip(map(tuple, vtk_to_numpy(grid.GetPoints().GetData()).tolist()), g.tolist()):
+        ids_at.setdefault(p, set()).add(i)
+    assert all(len(i) == 1 for i in ids_at.values()), "a point with two global ids"
+    assert len(ids_at) == len(unique), (len(ids_at), len(unique))
 
     inp = vtk.vtkXMLUnstructuredGridReader()
     inp.SetFileName(original)

@@ -1732,6 +1732,104 @@ fn pieces_read_per_rank_take_a_size_array_from_their_point_data() {
     );
 }
 
+/// Exact coordinates as a hashable key.
+fn coord_key(p: [f64; 3]) -> [u64; 3] {
+    p.map(|c| if c == 0.0 { 0 } else { c.to_bits() })
+}
+
+#[test]
+fn a_point_two_ranks_share_without_a_face_gets_one_global_id() {
+    // The ladder touches itself along edges and at a vertex: split between
+    // ranks, a point can be held by two pieces that share no face there (a
+    // pinch). Read piece by piece, the pieces' GlobalPointIds must number
+    // the distinct coordinates of their union densely, one id per point.
+    // The test finds the pinches itself (a point several pieces hold, one
+    // of which shares no face through it with any other piece), so a cut
+    // without any cannot pass for a test of them.
+    let dir = tempfile::tempdir().unwrap();
+    let s = |p: &Path| p.to_str().unwrap().to_string();
+    let mut pinches_seen = 0;
+    let runs: [(u32, &[&str]); 2] = [
+        (4, &["--steps", "0", "--allow-steps-zero"]),
+        (3, &["--stop-after", "optimize"]),
+    ];
+    for (ranks, extra) in runs {
+        let out = dir.path().join(format!("l{ranks}.pvtu"));
+        let mut args = vec!["refine", "meshes/getfem_ladder.vtu", "-o"];
+        let o = s(&out);
+        args.push(&o);
+        args.extend(extra);
+        mpirun_ok(ranks, &args);
+        let what = format!("-n {ranks} {extra:?}");
+        // Per distinct coordinates: the ids given, the pieces holding it.
+        let mut ids: HashMap<[u64; 3], std::collections::BTreeSet<i64>> = HashMap::new();
+        let mut holders: HashMap<[u64; 3], std::collections::BTreeSet<usize>> = HashMap::new();
+        // Per face (sorted corner keys): the pieces holding it.
+        let mut faces: HashMap<[[u64; 3]; 3], std::collections::BTreeSet<usize>> = HashMap::new();
+        let sources = piece_sources(&out);
+        assert_eq!(sources.len(), ranks as usize, "{what}");
+        for (k, src) in sources.iter().enumerate() {
+            let (d, meta) = tetrefine::io::read_mesh_with_meta(src).unwrap();
+            let g = &meta
+                .point_fields
+                .iter()
+                .find(|f| f.name == "GlobalPointIds")
+                .unwrap()
+                .values;
+            let mut used = vec![false; d.points.len()];
+            for t in &d.tets {
+                for &v in t {
+                    used[v as usize] = true;
+                }
+                for f in [[0, 1, 2], [0, 1, 3], [0, 2, 3], [1, 2, 3]] {
+                    let mut key = f.map(|i| coord_key(d.points[t[i] as usize]));
+                    key.sort_unstable();
+                    faces.entry(key).or_default().insert(k);
+                }
+            }
+            for (v, p) in d.points.iter().enumerate().filter(|&(v, _)| used[v]) {
+                ids.entry(coord_key(*p)).or_default().insert(g[v] as i64);
+                holders.entry(coord_key(*p)).or_default().insert(k);
+            }
+        }
+        // Per point: the pieces that share a face with another piece
+        // through it (the point is on their cut).
+        let mut on_cut: HashMap<[u64; 3], std::collections::BTreeSet<usize>> = HashMap::new();
+        for (f, hs) in &faces {
+            if hs.len() > 1 {
+                for p in f {
+                    on_cut.entry(*p).or_default().extend(hs);
+                }
+            }
+        }
+        // Pinches: points held by several pieces, one of which shares no
+        // face through it with any other piece.
+        let pinches = holders
+            .iter()
+            .filter(|(p, hs)| {
+                hs.len() > 1
+                    && hs
+                        .iter()
+                        .any(|k| !on_cut.get(*p).is_some_and(|c| c.contains(k)))
+            })
+            .count();
+        pinches_seen += pinches;
+        let two_ids = ids.values().filter(|s| s.len() > 1).count();
+        assert_eq!(
+            two_ids, 0,
+            "{what}: {pinches} pinches, {two_ids} points with two ids"
+        );
+        let all: std::collections::BTreeSet<i64> = ids.values().flatten().copied().collect();
+        assert_eq!(all.len(), ids.len(), "{what}: one point per id");
+        assert_eq!(
+            all.into_iter().collect::<Vec<_>>(),
+            (0..ids.len() as i64).collect::<Vec<_>>(),
+            "{what}: ids 0..n-1"
+        );
+    }
+    assert!(pinches_seen > 0, "no run split the ladder at a pinch");
+}
+
 #[test]
 fn pieces_whose_cut_has_moved_read_per_rank_step_as_the_serial_mesh_with_their_cut_marked() {
     // Pieces written after the cut move: there the cut can meet itself at

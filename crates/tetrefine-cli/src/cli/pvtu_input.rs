@@ -156,8 +156,10 @@ pub fn own_pieces<'a>(comm: &Comm, all: &'a [PathBuf]) -> Vec<(usize, &'a PathBu
 /// Across ranks: every `GlobalPointIds` value names one point. Each
 /// (id, point) pair goes to the rank its id names (modulo the rank count);
 /// there, an id seen with two different points is an error naming the
-/// pieces that disagree. (Two ids for one point are not an error: a point
-/// two ranks share without a shared face gets one from each.)
+/// pieces that disagree. (Two ids for one point are not an error: pieces
+/// written before [`tetrefine::distributed::global_point_ids`] matched
+/// every boundary point gave a point two ranks share without a shared face
+/// one id from each, and the points are joined by coordinates too.)
 fn check_point_ids(
     comm: &Comm,
     all: &[PathBuf],

@@ -274,8 +274,9 @@ pub fn merge_pieces(
                     Some(&at) => at,
                     None => {
                         // Equal coordinates are one point even under two
-                        // ids: a point two ranks share without a shared
-                        // face (a pinch) gets an id from each.
+                        // ids: in pieces written by an earlier version, a
+                        // point two ranks share without a shared face (a
+                        // pinch) has an id from each.
                         let at = *by_key.entry(key(x)).or_insert(next);
                         by_gid.insert(g, at);
                         at
