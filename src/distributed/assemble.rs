@@ -10,11 +10,14 @@ use super::part::{FaceFate, MarkerSlots, Part, Reader, Wire};
 use super::LocalMesh;
 use crate::mesh::fasthash::FastHashMap;
 use crate::mesh::{TetMesh, NO_ADJ};
+use crate::refine::size::SizeMap;
 
 /// Turns this rank's `mesh` (its pieces, merged, features detected) into its
 /// part: every boundary face another rank also holds becomes a partition
 /// face towards it, the user face markers of all ranks share one slot
 /// table, and tet `i` gets `parent` `first_tet + i` (its global input id).
+/// `size`, a size map over `mesh`'s points, becomes the part's
+/// ([`LocalMesh::size`], over the part's points).
 ///
 /// Feature edges on the shared faces' edges and corners at their vertices
 /// are dropped: a rank sees only its side of them, so what it detected
@@ -25,7 +28,12 @@ use crate::mesh::{TetMesh, NO_ADJ};
 ///
 /// An error on every rank when a face is held by more than two ranks'
 /// tets, or twice by one rank (overlapping pieces).
-pub fn assemble(comm: &Comm, mut mesh: TetMesh, first_tet: u32) -> Result<LocalMesh, String> {
+pub fn assemble(
+    comm: &Comm,
+    mut mesh: TetMesh,
+    first_tet: u32,
+    size: Option<&SizeMap>,
+) -> Result<LocalMesh, String> {
     let me = comm.rank;
     let boundary: Vec<(u32, usize)> = mesh
         .tet_ids()
@@ -98,17 +106,17 @@ pub fn assemble(comm: &Comm, mut mesh: TetMesh, first_tet: u32) -> Result<LocalM
         }
     });
     part.parent = (0..ids.len() as u32).map(|i| first_tet + i).collect();
+    if let Some(m) = size {
+        part.attach_sizes(&mesh, &ids, m);
+    }
+    let size = part.sizes.take();
     drop(mesh);
     let built = part
         .build()
         .map(|(m, _)| m)
         .map_err(|e| format!("rank {me}: its part with the cut marked: {e}"));
     let mesh = comm.agree(built)?;
-    Ok(LocalMesh {
-        mesh,
-        slots,
-        size: None,
-    })
+    Ok(LocalMesh { mesh, slots, size })
 }
 
 /// The user face markers of every rank's `mesh`, as one slot table.

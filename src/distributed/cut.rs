@@ -376,14 +376,34 @@ fn gather_f64(comm: &Comm, x: f64) -> Result<f64, String> {
     Ok(all.into_iter().map(f64::from_bits).sum())
 }
 
+/// The keys of the points on `mesh`'s boundary faces (the domain's and the
+/// cut's), each once: the only points another rank can hold too (an
+/// interior point has its whole ball of tets in this part). They include
+/// the points two ranks share without sharing a face (a pinch: where a
+/// non-manifold input, or a cut meeting itself, touches another part at a
+/// point or an edge only), which no partition face names.
+fn boundary_point_keys(mesh: &TetMesh) -> Vec<PointKey> {
+    let mut pts = std::collections::BTreeSet::new();
+    for t in mesh.tet_ids() {
+        for f in 0..4 {
+            if mesh.adj(t)[f] == NO_ADJ {
+                pts.extend(mesh.face_vertices(t, f));
+            }
+        }
+    }
+    pts.iter().map(|&v| point_key(mesh.point(v))).collect()
+}
+
 /// Global point ids: each shared point belongs to the lowest rank holding
 /// it, every rank numbers the points it owns after those of the ranks
 /// before it, and the owners' ids reach the other holders through the
-/// points' home ranks. Per local point, its id; points no tet uses get
-/// `u64::MAX`.
+/// points' home ranks. Shared points are found by their exact coordinates
+/// among every boundary point of every part (not only the cut's), so a
+/// point two ranks share without a face between them gets one id too. Per
+/// local point, its id; points no tet uses get `u64::MAX`.
 pub fn global_point_ids(comm: &Comm, mesh: &TetMesh) -> Result<Vec<u64>, String> {
-    let keys = cut_keys(mesh);
-    let holders = gather_at_home(comm, &keys.points)?;
+    let keys = boundary_point_keys(mesh);
+    let holders = gather_at_home(comm, &keys)?;
     // Home tells each holder the owner.
     let mut out: Vec<Wire> = (0..comm.size).map(|_| Wire::default()).collect();
     for (k, hs) in &holders {
@@ -430,7 +450,7 @@ pub fn global_point_ids(comm: &Comm, mesh: &TetMesh) -> Result<Vec<u64>, String>
         .filter(|&v| used[v as usize])
         .map(|v| (point_key(mesh.point(v)), v))
         .collect();
-    for k in &keys.points {
+    for k in &keys {
         if owner.get(k) == Some(&comm.rank) {
             let w = &mut out[home(k, comm.size)];
             w.key(k);

@@ -1101,28 +1101,7 @@ fn a_bad_pvtu_piece_ends_every_rank_naming_the_file() {
     let pieces = piece_sources(&a);
     let out = dir.path().join("o.pvtu");
     let fails = |ranks: u32, what: &str, expect: &[&str]| {
-        let o = Command::new("timeout")
-            .args([
-                "300",
-                "mpirun",
-                "--allow-run-as-root",
-                "--oversubscribe",
-                "-n",
-            ])
-            .arg(ranks.to_string())
-            .arg(env!("CARGO_BIN_EXE_tetrefine"))
-            .args(["refine", &s(&a), "-o", &s(&out)])
-            .current_dir(support::root())
-            .output()
-            .unwrap();
-        assert_ne!(o.status.code(), Some(124), "{what}: the job hung");
-        assert!(!o.status.success(), "{what}");
-        let err = String::from_utf8_lossy(&o.stderr);
-        for e in expect {
-            assert!(err.contains(e), "{what}: {err}");
-        }
-        assert!(!out.exists(), "{what}");
-        assert!(!piece_sources_exist(&out), "{what}");
+        fails_without_output(ranks, &a, &out, &[], what, expect);
     };
     // Fewer pieces than ranks.
     fails(3, "3 ranks", &["a.pvtu", "2 pieces for 3 ranks"]);
@@ -1159,10 +1138,194 @@ fn a_bad_pvtu_piece_ends_every_rank_naming_the_file() {
     fails(2, "missing", &["a_1.vtu"]);
 }
 
+/// `mpirun -n ranks tetrefine refine PVTU -o OUT EXTRA…` fails (under a
+/// timeout: no hang) with every string of `expect` in its stderr, and
+/// leaves neither `OUT` nor any piece of it.
+fn fails_without_output(
+    ranks: u32,
+    pvtu: &Path,
+    out: &Path,
+    extra: &[&str],
+    what: &str,
+    expect: &[&str],
+) {
+    let o = Command::new("timeout")
+        .args([
+            "300",
+            "mpirun",
+            "--allow-run-as-root",
+            "--oversubscribe",
+            "-n",
+        ])
+        .arg(ranks.to_string())
+        .arg(env!("CARGO_BIN_EXE_tetrefine"))
+        .arg("refine")
+        .arg(pvtu)
+        .arg("-o")
+        .arg(out)
+        .args(extra)
+        .current_dir(support::root())
+        .output()
+        .unwrap();
+    assert_ne!(o.status.code(), Some(124), "{what}: the job hung");
+    assert!(!o.status.success(), "{what}");
+    let err = String::from_utf8_lossy(&o.stderr);
+    for e in expect {
+        assert!(err.contains(e), "{what}: {err}");
+    }
+    assert!(!err.contains("panicked"), "{what}: {err}");
+    assert!(!out.exists(), "{what}");
+    assert!(!piece_sources_exist(out), "{what}");
+}
+
+/// Writes an ASCII `.vtu` of its own (not the code under test's writer):
+/// `points`, the tetrahedra `tets` (0-based, any orientation), the point
+/// array `GlobalPointIds`, the cell array `region` (unless `regions` is
+/// empty) and the point arrays `arrays` (name, components, values; their
+/// count is not checked: a wrong one is written as given).
+fn write_ascii_vtu(
+    path: &Path,
+    points: &[[f64; 3]],
+    tets: &[[u32; 4]],
+    gids: &[i64],
+    regions: &[i32],
+    arrays: &[(&str, usize, &[f64])],
+) {
+    let join = |it: &mut dyn Iterator<Item = String>| it.collect::<Vec<_>>().join(" ");
+    let extra: String = arrays
+        .iter()
+        .map(|(name, c, v)| {
+            format!(
+                "        <DataArray type=\"Float64\" Name=\"{name}\" NumberOfComponents=\"{c}\" format=\"ascii\">{}</DataArray>\n",
+                join(&mut v.iter().map(|x| x.to_string()))
+            )
+        })
+        .collect();
+    let cell_data = if regions.is_empty() {
+        String::new()
+    } else {
+        format!(
+            "      <CellData>\n        <DataArray type=\"Int32\" Name=\"region\" format=\"ascii\">{}</DataArray>\n      </CellData>\n",
+            join(&mut regions.iter().map(|r| r.to_string()))
+        )
+    };
+    let xml = format!(
+        r#"<?xml version="1.0"?>
+<VTKFile type="UnstructuredGrid" version="1.0" byte_order="LittleEndian" header_type="UInt64">
+  <UnstructuredGrid>
+    <Piece NumberOfPoints="{np}" NumberOfCells="{nc}">
+      <PointData>
+        <DataArray type="Int64" Name="GlobalPointIds" format="ascii">{gids}</DataArray>
+{extra}      </PointData>
+{cell_data}
+      <Points>
+        <DataArray type="Float64" NumberOfComponents="3" format="ascii">{pts}</DataArray>
+      </Points>
+      <Cells>
+        <DataArray type="Int64" Name="connectivity" format="ascii">{conn}</DataArray>
+        <DataArray type="Int64" Name="offsets" format="ascii">{offs}</DataArray>
+        <DataArray type="UInt8" Name="types" format="ascii">{types}</DataArray>
+      </Cells>
+    </Piece>
+  </UnstructuredGrid>
+</VTKFile>
+"#,
+        np = points.len(),
+        nc = tets.len(),
+        gids = join(&mut gids.iter().map(|g| g.to_string())),
+        // `{}` writes the shortest text that reads back to the same f64.
+        pts = join(&mut points.iter().flatten().map(|x| x.to_string())),
+        conn = join(&mut tets.iter().flatten().map(|v| v.to_string())),
+        offs = join(&mut (1..=tets.len()).map(|i| (4 * i).to_string())),
+        types = join(&mut tets.iter().map(|_| "10".to_string())),
+    );
+    std::fs::write(path, xml).unwrap();
+}
+
 /// Whether any piece `OUT_r.vtu` of `out` exists.
 fn piece_sources_exist(out: &Path) -> bool {
     let stem = out.file_stem().unwrap().to_string_lossy().into_owned();
     (0..4).any(|r| out.with_file_name(format!("{stem}_{r}.vtu")).exists())
+}
+
+#[test]
+fn an_inverted_or_degenerate_tet_in_a_piece_ends_every_rank_naming_the_piece_and_the_tet() {
+    // Pieces written on two ranks; then piece 1 rewritten by the test's own
+    // XML with one tet corrupted: two of its point indices swapped
+    // (inverted), a point repeated, or its last point replaced by a new
+    // point at the coordinates of its second (four distinct indices, zero
+    // volume). Read per rank (2 ranks) and by one rank reading both: every
+    // rank ends, the message names the piece and the tet, no file is left.
+    let dir = tempfile::tempdir().unwrap();
+    let s = |p: &Path| p.to_str().unwrap().to_string();
+    let a = dir.path().join("a.pvtu");
+    mpirun_ok(
+        2,
+        &[
+            "refine",
+            "meshes/tripod.mesh",
+            "-o",
+            &s(&a),
+            "--boundary",
+            "linear",
+        ],
+    );
+    let pieces = piece_sources(&a);
+    let (d, meta) = tetrefine::io::read_mesh_with_meta(&pieces[1]).unwrap();
+    let gids: Vec<i64> = meta
+        .point_fields
+        .iter()
+        .find(|f| f.name == "GlobalPointIds")
+        .unwrap()
+        .values
+        .iter()
+        .map(|&g| g as i64)
+        .collect();
+    // The file as read, rewritten unchanged, is accepted (the test's writer
+    // is sound): the corruption alone makes the runs below fail.
+    write_ascii_vtu(&pieces[1], &d.points, &d.tets, &gids, &[], &[]);
+    let ok = dir.path().join("ok.pvtu");
+    mpirun_ok(
+        2,
+        &[
+            "refine",
+            &s(&a),
+            "-o",
+            &s(&ok),
+            "--steps",
+            "0",
+            "--allow-steps-zero",
+        ],
+    );
+    let k = d.tets.len() / 2;
+    let out = dir.path().join("o.pvtu");
+    let tet = format!("tetrahedron {}", k + 1);
+    let piece = pieces[1].file_name().unwrap().to_str().unwrap();
+    let mut t = d.tets.clone();
+    t[k].swap(0, 1);
+    write_ascii_vtu(&pieces[1], &d.points, &t, &gids, &[], &[]);
+    for ranks in [2, 1] {
+        let what = format!("inverted, -n {ranks}");
+        fails_without_output(ranks, &a, &out, &[], &what, &[piece, &tet, "inverted"]);
+    }
+    let mut t = d.tets.clone();
+    t[k][3] = t[k][0];
+    write_ascii_vtu(&pieces[1], &d.points, &t, &gids, &[], &[]);
+    for ranks in [2, 1] {
+        let what = format!("a repeated point, -n {ranks}");
+        fails_without_output(ranks, &a, &out, &[], &what, &[piece, &tet, "degenerate"]);
+    }
+    let mut t = d.tets.clone();
+    let mut points = d.points.clone();
+    points.push(d.points[t[k][1] as usize]);
+    t[k][3] = (points.len() - 1) as u32;
+    let mut ids = gids.clone();
+    ids.push(i64::from(i32::MAX));
+    write_ascii_vtu(&pieces[1], &points, &t, &ids, &[], &[]);
+    for ranks in [2, 1] {
+        let what = format!("coplanar points, -n {ranks}");
+        fails_without_output(ranks, &a, &out, &[], &what, &[piece, &tet, "degenerate"]);
+    }
 }
 
 /// A `.pvtu` written on two ranks has had one step (its pieces' `level`):
@@ -1380,28 +1543,16 @@ fn pieces_read_per_rank_take_hsiz_and_refuse_a_size_file() {
     let (off_cut, on_cut) = still_long(&String::from_utf8_lossy(&o.stderr));
     let (union, _) = union_of_pieces(&sized);
     assert_measures_kept("--hsiz per rank", &union, &vol_in, area_in);
-    let mut long = std::collections::HashSet::new();
-    for t in union.tet_ids() {
-        let v = union.tet(t);
-        for i in 0..4 {
-            for j in i + 1..4 {
-                let (p, q) = (union.point(v[i]), union.point(v[j]));
-                if (q - p).length() / 1.5 > std::f64::consts::SQRT_2 {
-                    long.insert((v[i].min(v[j]), v[i].max(v[j])));
-                }
-            }
-        }
-    }
-    assert_eq!(long.len(), off_cut + on_cut);
+    let long = edges_longer_than(&union, 1.5);
+    assert_eq!(long, off_cut + on_cut);
     let serial_out = dir.path().join("serial.vtu");
     let serial_args = args(&serial_out);
     let o = serial_ok(&serial_args.iter().map(String::as_str).collect::<Vec<_>>());
     let (serial_long, _) = still_long(&String::from_utf8_lossy(&o.stderr));
     assert!(serial_long > 0);
     assert!(
-        long.len() <= serial_long + serial_long / 4,
-        "{} edges still long on 2 ranks, {serial_long} serially",
-        long.len()
+        long <= serial_long + serial_long / 4,
+        "{long} edges still long on 2 ranks, {serial_long} serially"
     );
     let b = dir.path().join("b.pvtu");
     let o = mpirun(2, &["refine", &s(&a), "-o", &s(&b), "--size", "h.sol"]);
@@ -1412,6 +1563,271 @@ fn pieces_read_per_rank_take_hsiz_and_refuse_a_size_file() {
         "{err}"
     );
     assert!(!b.exists());
+}
+
+/// The edges of `mesh` longer than √2 times `h` (each once).
+fn edges_longer_than(mesh: &TetMesh, h: f64) -> usize {
+    let mut long = std::collections::HashSet::new();
+    for t in mesh.tet_ids() {
+        let v = mesh.tet(t);
+        for i in 0..4 {
+            for j in i + 1..4 {
+                let (p, q) = (mesh.point(v[i]), mesh.point(v[j]));
+                if (q - p).length() / h > std::f64::consts::SQRT_2 {
+                    long.insert((v[i].min(v[j]), v[i].max(v[j])));
+                }
+            }
+        }
+    }
+    long.len()
+}
+
+#[test]
+fn pieces_read_per_rank_take_a_size_array_from_their_point_data() {
+    // Pieces written on two ranks, rewritten by the test's own XML with a
+    // point array h = 1.5 at every point: read per rank with --size-array h
+    // they refine as with --hsiz 1.5 (the same tets, the same edges left
+    // long), keep the input's volumes, and report as still long exactly the
+    // union's edges longer than √2 times 1.5. A piece without the array,
+    // with a value ≤ 0, NaN, or one value too few, ends every rank naming
+    // the piece, with no output; so do lengths on one rank and a metric on
+    // the other (naming the .pvtu).
+    let dir = tempfile::tempdir().unwrap();
+    let s = |p: &Path| p.to_str().unwrap().to_string();
+    let a = dir.path().join("a.pvtu");
+    mpirun_ok(
+        2,
+        &[
+            "refine",
+            "meshes/tripod.mesh",
+            "-o",
+            &s(&a),
+            "--boundary",
+            "linear",
+        ],
+    );
+    let (vol_in, area_in) = measures(&input("meshes/tripod.mesh"));
+    let pieces = piece_sources(&a);
+    let read: Vec<_> = pieces
+        .iter()
+        .map(|p| {
+            let (d, meta) = tetrefine::io::read_mesh_with_meta(p).unwrap();
+            let gids: Vec<i64> = meta
+                .point_fields
+                .iter()
+                .find(|f| f.name == "GlobalPointIds")
+                .unwrap()
+                .values
+                .iter()
+                .map(|&g| g as i64)
+                .collect();
+            let regions: Vec<i32> = (0..d.tets.len()).map(|t| d.region(t)).collect();
+            (d, gids, regions)
+        })
+        .collect();
+    let write = |k: usize, h: &[f64]| {
+        let (d, gids, regions) = &read[k];
+        write_ascii_vtu(
+            &pieces[k],
+            &d.points,
+            &d.tets,
+            gids,
+            regions,
+            &[("h", 1, h)],
+        );
+    };
+    let constant = |k: usize| vec![1.5; read[k].0.points.len()];
+    for k in 0..pieces.len() {
+        write(k, &constant(k));
+    }
+    let run = |out: &Path, size: &[&str]| {
+        let mut args = vec!["refine", a.to_str().unwrap(), "-o", out.to_str().unwrap()];
+        args.extend(["--boundary", "linear"]);
+        args.extend(size);
+        let o = mpirun_ok(2, &args);
+        let err = String::from_utf8_lossy(&o.stderr).into_owned();
+        let (union, _) = union_of_pieces(out);
+        (union, still_long(&err))
+    };
+    let (by_array, long_array) = run(&dir.path().join("arr.pvtu"), &["--size-array", "h"]);
+    // The pieces' array is a field to --hsiz, which it would refuse.
+    let (by_hsiz, long_hsiz) = run(
+        &dir.path().join("hsiz.pvtu"),
+        &["--hsiz", "1.5", "--no-transfer"],
+    );
+    assert_measures_kept("--size-array per rank", &by_array, &vol_in, area_in);
+    let long = edges_longer_than(&by_array, 1.5);
+    assert!(long > 0);
+    assert_eq!(long, long_array.0 + long_array.1);
+    assert!(by_array.n_tets() > 4 * input("meshes/tripod.mesh").n_tets());
+    assert_eq!(by_array.n_tets(), by_hsiz.n_tets());
+    assert_eq!(by_array.n_points(), by_hsiz.n_points());
+    assert_eq!(long_array, long_hsiz);
+    assert_eq!(edges_longer_than(&by_hsiz, 1.5), long);
+    // Bad arrays, each in piece 1 (rank 1's).
+    let out = dir.path().join("o.pvtu");
+    let piece = pieces[1].file_name().unwrap().to_str().unwrap();
+    let size = ["--size-array", "h"];
+    fails_without_output(
+        2,
+        &a,
+        &out,
+        &["--size-array", "nope"],
+        "missing",
+        &[
+            pieces[0].file_name().unwrap().to_str().unwrap(),
+            "no point array",
+        ],
+    );
+    let (d, gids, regions) = &read[1];
+    write_ascii_vtu(&pieces[1], &d.points, &d.tets, gids, regions, &[]);
+    fails_without_output(
+        2,
+        &a,
+        &out,
+        &size,
+        "missing in one",
+        &[piece, "no point array"],
+    );
+    let n = d.points.len();
+    let mut h = constant(1);
+    h[n / 2] = 0.0;
+    write(1, &h);
+    let point = format!("point {}", n / 2 + 1);
+    fails_without_output(
+        2,
+        &a,
+        &out,
+        &size,
+        "zero",
+        &[piece, "--size-array h", &point],
+    );
+    h[n / 2] = -1.5;
+    write(1, &h);
+    fails_without_output(2, &a, &out, &size, "negative", &[piece, &point]);
+    h[n / 2] = f64::NAN;
+    write(1, &h);
+    fails_without_output(2, &a, &out, &size, "NaN", &[piece, "not a finite number"]);
+    write(1, &constant(1)[1..]);
+    fails_without_output(2, &a, &out, &size, "too short", &[piece, "values"]);
+    // A metric (6 components, 1/h² on the diagonal) on rank 1, lengths on
+    // rank 0: the map's points travel between ranks, so both must agree.
+    let m = 1.0 / (1.5 * 1.5);
+    let metric: Vec<f64> = (0..n).flat_map(|_| [m, 0.0, m, 0.0, 0.0, m]).collect();
+    write_ascii_vtu(
+        &pieces[1],
+        &d.points,
+        &d.tets,
+        gids,
+        regions,
+        &[("h", 6, &metric)],
+    );
+    fails_without_output(
+        2,
+        &a,
+        &out,
+        &size,
+        "a metric on one rank",
+        &["a.pvtu", "different numbers of components"],
+    );
+}
+
+/// Exact coordinates as a hashable key.
+fn coord_key(p: [f64; 3]) -> [u64; 3] {
+    p.map(|c| if c == 0.0 { 0 } else { c.to_bits() })
+}
+
+#[test]
+fn a_point_two_ranks_share_without_a_face_gets_one_global_id() {
+    // The ladder touches itself along edges and at a vertex: split between
+    // ranks, a point can be held by two pieces that share no face there (a
+    // pinch). Read piece by piece, the pieces' GlobalPointIds must number
+    // the distinct coordinates of their union densely, one id per point.
+    // The test finds the pinches itself (a point several pieces hold, one
+    // of which shares no face through it with any other piece), so a cut
+    // without any cannot pass for a test of them.
+    let dir = tempfile::tempdir().unwrap();
+    let s = |p: &Path| p.to_str().unwrap().to_string();
+    let mut pinches_seen = 0;
+    let runs: [(u32, &[&str]); 2] = [
+        (4, &["--steps", "0", "--allow-steps-zero"]),
+        (3, &["--stop-after", "optimize"]),
+    ];
+    for (ranks, extra) in runs {
+        let out = dir.path().join(format!("l{ranks}.pvtu"));
+        let mut args = vec!["refine", "meshes/getfem_ladder.vtu", "-o"];
+        let o = s(&out);
+        args.push(&o);
+        args.extend(extra);
+        mpirun_ok(ranks, &args);
+        let what = format!("-n {ranks} {extra:?}");
+        // Per distinct coordinates: the ids given, the pieces holding it.
+        let mut ids: HashMap<[u64; 3], std::collections::BTreeSet<i64>> = HashMap::new();
+        let mut holders: HashMap<[u64; 3], std::collections::BTreeSet<usize>> = HashMap::new();
+        // Per face (sorted corner keys): the pieces holding it.
+        let mut faces: HashMap<[[u64; 3]; 3], std::collections::BTreeSet<usize>> = HashMap::new();
+        let sources = piece_sources(&out);
+        assert_eq!(sources.len(), ranks as usize, "{what}");
+        for (k, src) in sources.iter().enumerate() {
+            let (d, meta) = tetrefine::io::read_mesh_with_meta(src).unwrap();
+            let g = &meta
+                .point_fields
+                .iter()
+                .find(|f| f.name == "GlobalPointIds")
+                .unwrap()
+                .values;
+            let mut used = vec![false; d.points.len()];
+            for t in &d.tets {
+                for &v in t {
+                    used[v as usize] = true;
+                }
+                for f in [[0, 1, 2], [0, 1, 3], [0, 2, 3], [1, 2, 3]] {
+                    let mut key = f.map(|i| coord_key(d.points[t[i] as usize]));
+                    key.sort_unstable();
+                    faces.entry(key).or_default().insert(k);
+                }
+            }
+            for (v, p) in d.points.iter().enumerate().filter(|&(v, _)| used[v]) {
+                ids.entry(coord_key(*p)).or_default().insert(g[v] as i64);
+                holders.entry(coord_key(*p)).or_default().insert(k);
+            }
+        }
+        // Per point: the pieces that share a face with another piece
+        // through it (the point is on their cut).
+        let mut on_cut: HashMap<[u64; 3], std::collections::BTreeSet<usize>> = HashMap::new();
+        for (f, hs) in &faces {
+            if hs.len() > 1 {
+                for p in f {
+                    on_cut.entry(*p).or_default().extend(hs);
+                }
+            }
+        }
+        // Pinches: points held by several pieces, one of which shares no
+        // face through it with any other piece.
+        let pinches = holders
+            .iter()
+            .filter(|(p, hs)| {
+                hs.len() > 1
+                    && hs
+                        .iter()
+                        .any(|k| !on_cut.get(*p).is_some_and(|c| c.contains(k)))
+            })
+            .count();
+        pinches_seen += pinches;
+        let two_ids = ids.values().filter(|s| s.len() > 1).count();
+        assert_eq!(
+            two_ids, 0,
+            "{what}: {pinches} pinches, {two_ids} points with two ids"
+        );
+        let all: std::collections::BTreeSet<i64> = ids.values().flatten().copied().collect();
+        assert_eq!(all.len(), ids.len(), "{what}: one point per id");
+        assert_eq!(
+            all.into_iter().collect::<Vec<_>>(),
+            (0..ids.len() as i64).collect::<Vec<_>>(),
+            "{what}: ids 0..n-1"
+        );
+    }
+    assert!(pinches_seen > 0, "no run split the ladder at a pinch");
 }
 
 #[test]

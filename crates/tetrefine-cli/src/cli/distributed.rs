@@ -64,9 +64,9 @@ pub fn run(a: Args) -> super::CliResult {
     }
     let plan = super::size::plan(&a)?;
     let n_steps = plan.n_steps;
-    if pvtu_in && (a.size.is_some() || a.size_array.is_some()) {
+    if pvtu_in && a.size.is_some() {
         return Err(format!(
-            "{} is read per rank (a .pvtu input with a .pvtu output), and --size/--size-array number the points of one whole mesh: write a .vtu output (rank 0 reads the whole input), or give --hsiz/--hmax",
+            "{} is read per rank (a .pvtu input with a .pvtu output), and --size numbers the points of one whole mesh: write a .vtu output (rank 0 reads the whole input), or give --size-array NAME (a point array of the pieces), --hsiz or --hmax",
             a.input.display()
         ));
     }
@@ -81,9 +81,9 @@ pub fn run(a: Args) -> super::CliResult {
     let mut steps = Vec::new();
     let (mut input, meta, selection, transfer, mut local, first_selection) = if pvtu_in {
         // Every rank reads its own pieces; nobody holds the whole input.
-        let mut local = super::pvtu_input::load_pieces(&comm, &a)?;
-        // --size and --size-array were refused above: --hsiz/--hmax only.
-        local.size = super::size::size_map_of(&a, &local.mesh, &Default::default())?;
+        // With its size map (--size-array, --hsiz, --hmax; --size was
+        // refused above).
+        let local = super::pvtu_input::load_pieces(&comm, &a)?;
         let c = dist::census(&comm, &local.mesh)?;
         let first = dist::global_stats(&comm, &local.mesh, &c)?;
         if root {

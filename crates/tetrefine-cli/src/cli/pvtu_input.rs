@@ -9,6 +9,7 @@
 use super::refine::Args;
 use std::path::PathBuf;
 use tetrefine::distributed::{self as dist, Comm, LocalMesh, Reader, Wire};
+use tetrefine::io::MeshMeta;
 use tetrefine::MeshData;
 
 /// Whether a distributed run reads its `.pvtu` input per rank: with a
@@ -31,8 +32,10 @@ pub fn per_rank(a: &Args) -> bool {
 }
 
 /// Every rank's share of the `.pvtu` input `a.input`, with its cut faces
-/// marked. A collective: a bad piece (missing, corrupt, an inverted tet,
-/// `GlobalPointIds` that disagree) ends every rank with an error naming
+/// marked and its size map (`--hsiz`/`--hmax`, or `--size-array NAME`: the
+/// point array NAME of its pieces). A collective: a bad piece (missing,
+/// corrupt, an inverted or degenerate tet, `GlobalPointIds` that disagree,
+/// a size array missing or not a size) ends every rank with an error naming
 /// the file.
 pub fn load_pieces(comm: &Comm, a: &Args) -> Result<LocalMesh, String> {
     let all = comm.agree(tetrefine::io::read_pvtu_pieces(&a.input).map_err(|e| e.to_string()))?;
@@ -46,15 +49,22 @@ pub fn load_pieces(comm: &Comm, a: &Args) -> Result<LocalMesh, String> {
         Ok(())
     })?;
     let mine = own_pieces(comm, &all);
-    let read = super::pvtu_merge::merge_pieces(&mine);
+    let size_array = a.size_array.as_deref();
+    let read = super::pvtu_merge::merge_pieces(&mine, size_array);
     let (data, ids, fields) = comm.agree(read)?;
+    if let Some(name) = size_array {
+        same_components(comm, a, name, &fields)?;
+    }
     // A rank holds its own pieces only: it could not interpolate their
-    // fields at points that the cut move brings from another rank.
+    // fields at points that the cut move brings from another rank. (The
+    // size array is no field of the output: its values travel with the
+    // points as the size map.)
     let names: Vec<&str> = fields
         .point_fields
         .iter()
         .chain(&fields.cell_fields)
         .map(|f| f.name.as_str())
+        .filter(|n| Some(*n) != size_array)
         .collect();
     let with_fields = comm.sum(&[u64::from(!names.is_empty())])[0] > 0;
     comm.agree(if with_fields && !a.no_transfer && comm.rank == 0 {
@@ -80,6 +90,11 @@ pub fn load_pieces(comm: &Comm, a: &Args) -> Result<LocalMesh, String> {
             mesh
         });
     let mesh = comm.agree(built)?;
+    // `--hsiz`/`--hmax`, or `--size-array` from the pieces' point data
+    // (`--size FILE.sol` is refused before: it numbers one whole mesh).
+    let size = super::size::size_map(None, size_array, a.hsiz, a.hmax, &mesh, &fields)
+        .map_err(|e| format!("{}: {e}", super::pvtu_merge::names(&mine)));
+    let size = comm.agree(size)?;
     let counts = comm.all_gather(mesh.n_tets() as u64);
     let first: u64 = counts[..comm.rank as usize].iter().sum();
     let total: u64 = counts.iter().sum();
@@ -97,7 +112,33 @@ pub fn load_pieces(comm: &Comm, a: &Args) -> Result<LocalMesh, String> {
             a.input.display()
         );
     }
-    dist::assemble(comm, mesh, first as u32)
+    dist::assemble(comm, mesh, first as u32, size.as_ref())
+}
+
+/// Across ranks: the size array `name` has one number of components in
+/// every rank's pieces (a length everywhere, or a metric everywhere: the
+/// size map's points travel between ranks when the cut moves).
+fn same_components(comm: &Comm, a: &Args, name: &str, fields: &MeshMeta) -> super::CliResult {
+    let own = fields
+        .point_fields
+        .iter()
+        .find(|f| f.name == name)
+        .map_or(0, |f| f.components as u64);
+    let all = comm.all_gather(own);
+    comm.agree(if comm.rank == 0 && all.iter().any(|&c| c != all[0]) {
+        let each: Vec<String> = all
+            .iter()
+            .enumerate()
+            .map(|(r, c)| format!("{c} on rank {r}"))
+            .collect();
+        Err(format!(
+            "{}: --size-array {name} has different numbers of components in the pieces of different ranks ({}): give every piece lengths (1) or every piece metrics (6)",
+            a.input.display(),
+            each.join(", ")
+        ))
+    } else {
+        Ok(())
+    })
 }
 
 /// The pieces (index, path) rank `comm.rank` reads of `all`: a contiguous
@@ -115,8 +156,10 @@ pub fn own_pieces<'a>(comm: &Comm, all: &'a [PathBuf]) -> Vec<(usize, &'a PathBu
 /// Across ranks: every `GlobalPointIds` value names one point. Each
 /// (id, point) pair goes to the rank its id names (modulo the rank count);
 /// there, an id seen with two different points is an error naming the
-/// pieces that disagree. (Two ids for one point are not an error: a point
-/// two ranks share without a shared face gets one from each.)
+/// pieces that disagree. (Two ids for one point are not an error: pieces
+/// written before [`tetrefine::distributed::global_point_ids`] matched
+/// every boundary point gave a point two ranks share without a shared face
+/// one id from each, and the points are joined by coordinates too.)
 fn check_point_ids(
     comm: &Comm,
     all: &[PathBuf],

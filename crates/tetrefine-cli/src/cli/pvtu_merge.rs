@@ -33,7 +33,7 @@ pub fn names(pieces: &[(usize, &PathBuf)]) -> String {
 pub fn read_pvtu(path: &std::path::Path) -> Result<(MeshData, MeshMeta), String> {
     let all = tetrefine::io::read_pvtu_pieces(path).map_err(|e| e.to_string())?;
     let pieces: Vec<(usize, &PathBuf)> = all.iter().enumerate().collect();
-    let (data, _, meta) = merge_pieces(&pieces)?;
+    let (data, _, meta) = merge_pieces(&pieces, None)?;
     Ok((data, meta))
 }
 
@@ -102,6 +102,86 @@ impl FieldMerge {
     }
 }
 
+/// Every tet of the piece at `path` (read as `d`) has four distinct points
+/// and a positive volume (the exact orientation test the mesh builder
+/// uses). A piece is written oriented: an inverted or degenerate tet is a
+/// corrupt piece, named with the tet's number (1-based, in the piece's own
+/// order), its points (0-based, as a one-piece `.vtu`'s connectivity has them) and
+/// the line of the connectivity. Checked piece by piece, before the points
+/// of several pieces are joined (which would renumber them).
+fn check_tets(path: &std::path::Path, d: &MeshData) -> Result<(), String> {
+    use tetrefine::geom::{orient3d_sign, Orientation};
+    for (t, v) in d.tets.iter().enumerate() {
+        let distinct = (0..4).all(|i| (i + 1..4).all(|j| v[i] != v[j]));
+        let problem = if distinct {
+            let q = v.map(|x| glam::DVec3::from_array(d.points[x as usize]));
+            match orient3d_sign(q[0], q[1], q[2], q[3]) {
+                Orientation::Positive => continue,
+                Orientation::Negative => "is inverted (negative volume)",
+                Orientation::Zero => "is degenerate (zero volume: its four points are coplanar)",
+            }
+        } else {
+            "is degenerate (it repeats a point)"
+        };
+        let line = d
+            .tet_lines
+            .get(t)
+            .map_or_else(String::new, |l| format!(", connectivity at line {l}"));
+        return Err(format!(
+            "{}: tetrahedron {} (points {} {} {} {}{line}) {problem}: a corrupt piece",
+            path.display(),
+            t + 1,
+            v[0],
+            v[1],
+            v[2],
+            v[3]
+        ));
+    }
+    Ok(())
+}
+
+/// The point array `name` of the piece at `path` (read as `d` with `meta`)
+/// is a size map: there, 1 (a length) or 6 (a metric) components, one entry
+/// per point, each a positive finite length or a positive-definite metric.
+/// Returns its number of components; an error names the piece, the array
+/// and the problem (for a bad value, the point, 1-based in the piece).
+pub fn check_size_array(
+    path: &std::path::Path,
+    d: &MeshData,
+    meta: &MeshMeta,
+    name: &str,
+) -> Result<usize, String> {
+    let f =
+        meta.point_fields
+            .iter()
+            .find(|f| f.name == name)
+            .ok_or_else(|| {
+                let names: Vec<&str> = meta
+                    .point_fields
+                    .iter()
+                    .map(|f| f.name.as_str())
+                    .filter(|n| !RUN_POINT_ARRAYS.contains(n))
+                    .collect();
+                format!(
+                "{}: --size-array {name}: the piece has no point array of that name (it has: {})",
+                path.display(),
+                if names.is_empty() { "none".to_string() } else { names.join(", ") }
+            )
+            })?;
+    let n = d.points.len();
+    if f.values.len() != n * f.components {
+        return Err(format!(
+            "{}: --size-array {name}: {} values for {n} points of {} components",
+            path.display(),
+            f.values.len(),
+            f.components
+        ));
+    }
+    tetrefine::SizeMap::from_values(f.components, &f.values)
+        .map_err(|e| format!("{}: --size-array {name}: {e}", path.display()))?;
+    Ok(f.components)
+}
+
 /// Per merged point: its `GlobalPointIds` value (when the pieces carry
 /// them) and the index of the piece it was first read from.
 pub type PointIds = Vec<(Option<u64>, usize)>;
@@ -109,14 +189,32 @@ pub type PointIds = Vec<(Option<u64>, usize)>;
 /// This rank's pieces as one mesh: points shared by `GlobalPointIds` when
 /// every piece has them (and by exact coordinates: equal coordinates are
 /// one point), else by exact coordinates alone. A piece that cannot be
-/// read, holds an inverted tet, or gives one id to two points is an error
-/// naming it.
+/// read, holds an inverted or degenerate tet, or gives one id to two points is an error
+/// naming it. With `size_array` (`--size-array NAME`), every piece must
+/// carry the point array NAME as a size map (see [`check_size_array`]),
+/// with one number of components in all of them.
 pub fn merge_pieces(
     pieces: &[(usize, &PathBuf)],
+    size_array: Option<&str>,
 ) -> Result<(MeshData, PointIds, MeshMeta), String> {
     let mut read = Vec::with_capacity(pieces.len());
+    let mut size_components: Option<(usize, &PathBuf)> = None;
     for &(i, path) in pieces {
         let (d, meta) = tetrefine::io::read_mesh_with_meta(path).map_err(|e| e.to_string())?;
+        if let Some(name) = size_array {
+            let c = check_size_array(path, &d, &meta, name)?;
+            match size_components {
+                Some((c0, first)) if c0 != c => {
+                    return Err(format!(
+                        "{}: --size-array {name} has {c} components here and {c0} in {}",
+                        path.display(),
+                        first.display()
+                    ))
+                }
+                Some(_) => {}
+                None => size_components = Some((c, path)),
+            }
+        }
         let gids = match meta
             .point_fields
             .iter()
@@ -142,16 +240,7 @@ pub fn merge_pieces(
             }
             None => None,
         };
-        if let Some(t) = d.tets.iter().position(|t| {
-            let q = t.map(|v| glam::DVec3::from_array(d.points[v as usize]));
-            tetrefine::geom::tet_volume(&q) < 0.0
-        }) {
-            return Err(format!(
-                "{}: tetrahedron {} is inverted (negative volume): a corrupt piece",
-                path.display(),
-                t + 1
-            ));
-        }
+        check_tets(path, &d)?;
         read.push((i, path, d, gids, meta));
     }
     let by_id = read.iter().all(|r| r.3.is_some());
@@ -185,8 +274,9 @@ pub fn merge_pieces(
                     Some(&at) => at,
                     None => {
                         // Equal coordinates are one point even under two
-                        // ids: a point two ranks share without a shared
-                        // face (a pinch) gets an id from each.
+                        // ids: in pieces written by an earlier version, a
+                        // point two ranks share without a shared face (a
+                        // pinch) has an id from each.
                         let at = *by_key.entry(key(x)).or_insert(next);
                         by_gid.insert(g, at);
                         at

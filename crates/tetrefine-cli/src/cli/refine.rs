@@ -39,7 +39,9 @@ pub struct Args {
     #[arg(long)]
     pub size: Option<PathBuf>,
     /// The size map is this point array of the input (`.vtu` point data or
-    /// Gmsh `$NodeData`; 1 component: a length, 6: a metric).
+    /// Gmsh `$NodeData`; 1 component: a length, 6: a metric). A `.pvtu`
+    /// read per rank (under `mpirun`, with a `.pvtu` output) takes it from
+    /// each rank's own pieces.
     #[arg(long)]
     pub size_array: Option<String>,
     /// A uniform target edge length (MMG's -hsiz).
