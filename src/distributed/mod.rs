@@ -71,7 +71,11 @@ pub struct LocalMesh {
 const CUT_MOVES: usize = 1;
 /// Layers of tets each move carries across: with two, the band along the
 /// old cut (one layer) keeps a free layer between it and the new cut.
-const CUT_LAYERS: usize = 2;
+const CUT_LAYERS: usize = 3;
+/// Rings of tets around the old cut's points the optimize phase runs over
+/// after a move: two, so that the vertices next to the frozen ones move
+/// with their whole balls.
+const BAND_RINGS: usize = 2;
 
 /// Options of [`refine_distributed`].
 #[derive(Clone, Debug)]
@@ -294,16 +298,20 @@ fn band_zone(
         .collect();
     let refined = refined_only.then(|| descendants_of_last_step(mesh, step));
     let mut tets = vec![false; mesh.n_tet_slots()];
-    let mut verts = vec![false; mesh.n_points()];
-    for t in mesh.tet_ids() {
-        let v = mesh.tet(t);
-        let allowed = refined.as_ref().is_none_or(|r| r[t as usize]);
-        if allowed && v.iter().any(|&x| on_cut[x as usize]) {
-            tets[t as usize] = true;
-            for x in v {
-                verts[x as usize] = true;
+    let mut verts = on_cut;
+    for _ in 0..BAND_RINGS {
+        let mut next = verts.clone();
+        for t in mesh.tet_ids() {
+            let v = mesh.tet(t);
+            let allowed = refined.as_ref().is_none_or(|r| r[t as usize]);
+            if allowed && v.iter().any(|&x| verts[x as usize]) {
+                tets[t as usize] = true;
+                for x in v {
+                    next[x as usize] = true;
+                }
             }
         }
+        verts = next;
     }
     (verts, tets)
 }

@@ -223,6 +223,11 @@ pub(crate) fn optimize_phase(
             opts.hausd,
         )
     };
+    if frozen_band {
+        // The band had only the first passes, without its interface
+        // vertices: it gets the settling round's edge-removal bar.
+        io.edge_threshold = io.edge_threshold.max(SETTLE_EDGE_THRESHOLD);
+    }
     keep_domain_for(&mut io, opts.boundary);
     // Long edges are split once the passes have evened out the
     // step's new points (split on the raw √3 mesh they gain
