@@ -615,7 +615,7 @@ impl Mesh {
     ///   opt_passes    Passes of the optimize phase (edge removal +
     ///                 smoothing); 0 skips it [--opt-passes] (default 3).
     ///   threshold     Minimum-sine quality below which vertices get
-    ///                 optimization-based smoothing [--threshold] (0.33).
+    ///                 optimization-based smoothing [--threshold] (0.35).
     ///   stop_after    Stop each step after this phase: 'split', 'flip',
     ///                 'boundary-split', 'boundary-flip', 'boundary-smooth',
     ///                 'optimize' [--stop-after].
@@ -699,14 +699,14 @@ impl Mesh {
     /// Bad options raise ValueError with the CLI's message; an unreadable
     /// features file raises OSError.
     #[pyo3(
-        signature = (steps=None, *, boundary="interpolating", opt_passes=3, threshold=0.33,
+        signature = (steps=None, *, boundary="interpolating", opt_passes=3, threshold=0.35,
                      stop_after=None, features=PathOrName("auto".into()), feature_angle=45.0, indicator=None,
                      mark=None, region=None, r#box=None, sphere=None, smooth="refined",
                      step_offset=0, progress=None, stats=false, allow_empty=false,
                      allow_steps_zero=false, point_fields=None, cell_fields=None,
                      transfer=None, vertex_parents=false, size=None, hsiz=None, hmax=None,
                      effort="default", hausd=None, interfaces="linear"),
-        text_signature = "(self, steps=None, *, boundary='interpolating', opt_passes=3, threshold=0.33, stop_after=None, features='auto', feature_angle=45.0, indicator=None, mark='doerfler:0.5', region=None, box=None, sphere=None, smooth='refined', step_offset=0, progress=False, stats=False, allow_empty=False, allow_steps_zero=False, point_fields=None, cell_fields=None, transfer=None, vertex_parents=False, size=None, hsiz=None, hmax=None, effort='default', hausd=None, interfaces='linear')"
+        text_signature = "(self, steps=None, *, boundary='interpolating', opt_passes=3, threshold=0.35, stop_after=None, features='auto', feature_angle=45.0, indicator=None, mark='doerfler:0.5', region=None, box=None, sphere=None, smooth='refined', step_offset=0, progress=False, stats=False, allow_empty=False, allow_steps_zero=False, point_fields=None, cell_fields=None, transfer=None, vertex_parents=False, size=None, hsiz=None, hmax=None, effort='default', hausd=None, interfaces='linear')"
     )]
     #[allow(clippy::too_many_arguments)]
     fn refine(
@@ -893,7 +893,7 @@ impl Mesh {
     ///   opt_passes     Maximum passes of edge removal + smoothing
     ///                  [--opt-passes] (default 5).
     ///   threshold      Minimum-sine quality below which vertices get
-    ///                  optimization-based smoothing (0.33).
+    ///                  optimization-based smoothing (0.35).
     ///   effort         'fast' (boundary fixed), 'default' or 'best'
     ///                  [--effort].
     ///   hausd          Hausdorff bound of boundary moves; None: 5 % of the
@@ -901,7 +901,7 @@ impl Mesh {
     ///                  for its removal) [--hausd].
     ///   features       'auto' or 'none' [--features].
     ///   feature_angle  Crease angle for 'auto', degrees [--feature-angle].
-    #[pyo3(signature = (opt_passes=5, *, threshold=0.33, effort="default", hausd=None,
+    #[pyo3(signature = (opt_passes=5, *, threshold=0.35, effort="default", hausd=None,
                         features="auto", feature_angle=45.0))]
     #[allow(clippy::too_many_arguments)]
     fn improve(
