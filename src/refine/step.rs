@@ -273,7 +273,7 @@ pub(crate) fn optimize_phase(
 /// edge-removal rings, boundary moves up to a higher bar) over the tets below
 /// the floor and the tets sharing a vertex with them, inside the zone `io`
 /// allows (`movable`, `tet_allowed` as in [`ImproveOptions`]). `None` when
-/// no tet is below the floor. Measured: the holed bar
+/// no tet is below the floor or the floor is above [`FLOOR_BAR_CAP`]. Measured: the holed bar
 /// refined twice left one wedge at 17.86° against its input's 19.34° (a
 /// corner vertex and three boundary vertices, two short opposite edges);
 /// the round lifts it for a few milliseconds.
@@ -284,7 +284,9 @@ fn rescue_options(
     opts: &RefineOptions,
     floor: f64,
 ) -> Option<ImproveOptions> {
-    if floor <= 0.0 {
+    // A floor above the cap is aimed at, not kept (a Kuhn grid's 45° is out
+    // of a √3 step's reach): a rescue there would take the whole mesh.
+    if floor <= 0.0 || floor > FLOOR_BAR_CAP {
         return None;
     }
     let allowed = |t: u32| zone_tets.as_ref().is_none_or(|a| a[t as usize]);
