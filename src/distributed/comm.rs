@@ -160,6 +160,34 @@ impl Comm {
         }
     }
 
+    /// [`Comm::agree`] for a check every rank makes alike (of the command's
+    /// arguments, say): its message is printed once, by rank 0, not once
+    /// per rank. A rank whose failure rank 0 did not share prints its own
+    /// (and every rank waits for that print before going on).
+    pub fn agree_alike<T>(&self, local: Result<T, String>) -> Result<T, String> {
+        let failed = local.is_err();
+        if let Err(e) = &local {
+            if self.rank == 0 {
+                eprintln!("error: {e}");
+            }
+            FAILURE_PRINTED.store(true, Ordering::Relaxed);
+        }
+        let root_failed = failed && self.rank == 0;
+        let s = self.sum(&[u64::from(failed), u64::from(root_failed)]);
+        if s[0] > 0 && s[1] == 0 {
+            if let Err(e) = &local {
+                eprintln!("error: {e}");
+            }
+            // No rank leaves (and ends the job) before those prints.
+            self.barrier();
+        }
+        match local {
+            Err(e) => Err(e),
+            Ok(_) if s[0] > 0 => Err(OTHER_RANK_FAILED.to_string()),
+            Ok(x) => Ok(x),
+        }
+    }
+
     /// Waits for every rank.
     pub fn barrier(&self) {
         self.world.barrier();

@@ -118,11 +118,18 @@ pub(super) fn gather_at_home<const N: usize>(
     Ok(holders)
 }
 
-/// The cut as a rank sees it: its shared points, edges and faces.
+/// What a rank can share with another, as keys the same on every rank: the
+/// points and edges of its boundary faces (the domain's and the cut's, so
+/// those two ranks share at a pinch, without a face between them, are in),
+/// with the points of the partition faces apart, and the partition faces.
 struct CutKeys {
+    /// Points of every boundary face.
     points: Vec<PointKey>,
     /// Per point: is it a corner?
     corner: Vec<bool>,
+    /// Points of the partition faces only (each must have another holder).
+    cut_points: Vec<PointKey>,
+    /// Edges of every boundary face.
     edges: Vec<[u64; 6]>,
     /// Per edge: is it a feature edge?
     feature: Vec<bool>,
@@ -130,35 +137,41 @@ struct CutKeys {
 }
 
 fn cut_keys(mesh: &TetMesh) -> CutKeys {
-    let faces = partition_faces(mesh);
     let mut pts = std::collections::BTreeSet::new();
+    let mut cut_pts = std::collections::BTreeSet::new();
     let mut edges = std::collections::BTreeSet::new();
+    for t in mesh.tet_ids() {
+        for f in 0..4 {
+            if mesh.adj(t)[f] != NO_ADJ {
+                continue;
+            }
+            let fv = mesh.face_vertices(t, f);
+            pts.extend(fv);
+            for i in 0..3 {
+                let (a, b) = (fv[i], fv[(i + 1) % 3]);
+                edges.insert(if a < b { [a, b] } else { [b, a] });
+            }
+        }
+    }
+    let faces = partition_faces(mesh);
     let mut face_keys = Vec::with_capacity(faces.len());
     for &(t, f, _) in &faces {
-        let fv = mesh.face_vertices(t, f);
-        pts.extend(fv);
-        for i in 0..3 {
-            let (a, b) = (fv[i], fv[(i + 1) % 3]);
-            edges.insert(if a < b { [a, b] } else { [b, a] });
-        }
-        let k = face_key_of(mesh, t, f);
-        face_keys.push(flat(&k));
+        cut_pts.extend(mesh.face_vertices(t, f));
+        face_keys.push(flat(&face_key_of(mesh, t, f)));
     }
-    let points: Vec<PointKey> = pts.iter().map(|&v| point_key(mesh.point(v))).collect();
-    let corner = pts.iter().map(|&v| mesh.is_corner(v)).collect();
-    let edge_keys = edges
-        .iter()
-        .map(|&[a, b]| edge_coords(mesh, a, b))
-        .collect();
-    let feature = edges
-        .iter()
-        .map(|&[a, b]| mesh.is_feature_edge(a, b))
-        .collect();
+    let key = |&v: &u32| point_key(mesh.point(v));
     CutKeys {
-        points,
-        corner,
-        edges: edge_keys,
-        feature,
+        points: pts.iter().map(key).collect(),
+        corner: pts.iter().map(|&v| mesh.is_corner(v)).collect(),
+        cut_points: cut_pts.iter().map(key).collect(),
+        edges: edges
+            .iter()
+            .map(|&[a, b]| edge_coords(mesh, a, b))
+            .collect(),
+        feature: edges
+            .iter()
+            .map(|&[a, b]| mesh.is_feature_edge(a, b))
+            .collect(),
         faces: face_keys,
     }
 }
@@ -259,8 +272,8 @@ pub fn census(comm: &Comm, mesh: &TetMesh) -> Result<Census, String> {
     let keys = cut_keys(mesh);
     let face_holders = gather_at_home(comm, &keys.faces)?;
     let bad_faces = face_holders.values().filter(|h| h.len() != 2).count();
-    let point_holders = gather_at_home(comm, &keys.points)?;
-    let lonely = point_holders.values().filter(|h| h.len() < 2).count();
+    let cut_point_holders = gather_at_home(comm, &keys.cut_points)?;
+    let lonely = cut_point_holders.values().filter(|h| h.len() < 2).count();
     comm.agree(if bad_faces + lonely > 0 {
         Err(format!(
             "rank {}: the parts do not conform: {bad_faces} partition faces not held by exactly two ranks, {lonely} shared points held by one",
@@ -269,6 +282,8 @@ pub fn census(comm: &Comm, mesh: &TetMesh) -> Result<Census, String> {
     } else {
         Ok(())
     })?;
+    // Over-counts come from every boundary point and edge, pinches included.
+    let point_holders = gather_at_home(comm, &keys.points)?;
     let edge_holders = gather_at_home(comm, &keys.edges)?;
     // Flags travel as separate key sets: a corner (feature edge) is one of
     // the shared points (edges) that some rank calls so.

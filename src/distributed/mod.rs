@@ -226,7 +226,8 @@ pub fn refine_distributed(
         on_step(s, &stats, &report);
         last = Some((c, stats));
     }
-    if opts.improve_across_cut && comm.size > 1 {
+    // No step, no cut move: `--steps 0` hands the input on as it came.
+    if opts.improve_across_cut && comm.size > 1 && opts.steps > 0 {
         let mut o = opts.refine.clone();
         o.selection = None;
         for k in 1..=CUT_MOVES {

@@ -1562,6 +1562,8 @@ fn pieces_read_per_rank_take_hsiz_and_refuse_a_size_file() {
         err.contains("read per rank") && err.contains("--hsiz"),
         "{err}"
     );
+    // A check every rank makes alike is said once, not once per rank.
+    assert_eq!(err.matches("read per rank").count(), 1, "{err}");
     assert!(!b.exists());
 }
 
@@ -1664,6 +1666,65 @@ fn pieces_read_per_rank_take_a_size_array_from_their_point_data() {
     assert_eq!(by_array.n_points(), by_hsiz.n_points());
     assert_eq!(long_array, long_hsiz);
     assert_eq!(edges_longer_than(&by_hsiz, 1.5), long);
+    // A map that varies across the cut: h linear in x, 1.0 at the lowest x
+    // and 3.0 at the highest. Per rank it must refine as the serial command
+    // refines the same pieces read whole, and grade: edges near the high
+    // end come out longer than near the low end (a constant map, or one
+    // rank's values used for the other's points, would not).
+    let xs = || {
+        read.iter()
+            .flat_map(|(d, _, _)| d.points.iter().map(|p| p[0]))
+    };
+    let x0 = xs().fold(f64::INFINITY, f64::min);
+    let x1 = xs().fold(f64::NEG_INFINITY, f64::max);
+    let graded = |p: &[f64; 3]| 1.0 + 2.0 * (p[0] - x0) / (x1 - x0);
+    for (k, (d, _, _)) in read.iter().enumerate() {
+        let h: Vec<f64> = d.points.iter().map(graded).collect();
+        write(k, &h);
+    }
+    let (by_graded, _) = run(&dir.path().join("graded.pvtu"), &["--size-array", "h"]);
+    assert_measures_kept("graded --size-array per rank", &by_graded, &vol_in, area_in);
+    let serial_out = dir.path().join("graded.vtu");
+    serial_ok(&[
+        "refine",
+        a.to_str().unwrap(),
+        "-o",
+        serial_out.to_str().unwrap(),
+        "--boundary",
+        "linear",
+        "--size-array",
+        "h",
+    ]);
+    let serial = tetrefine::io::load_mesh(&serial_out).unwrap().0;
+    let (n_dist, n_serial) = (by_graded.n_tets() as f64, serial.n_tets() as f64);
+    assert!(
+        (n_dist - n_serial).abs() <= 0.1 * n_serial,
+        "graded map: {n_dist} tets on 2 ranks, {n_serial} serially"
+    );
+    for (what, m) in [("2 ranks", &by_graded), ("serial", &serial)] {
+        // Mean edge length in the lowest and the highest fifth of x.
+        let (mut low, mut high) = ((0.0, 0usize), (0.0, 0usize));
+        for t in m.tet_ids() {
+            let v = m.tet(t);
+            for i in 0..4 {
+                for j in i + 1..4 {
+                    let (p, q) = (m.point(v[i]), m.point(v[j]));
+                    let at = (0.5 * (p.x + q.x) - x0) / (x1 - x0);
+                    let bin = if at < 0.2 {
+                        &mut low
+                    } else if at > 0.8 {
+                        &mut high
+                    } else {
+                        continue;
+                    };
+                    bin.0 += (q - p).length();
+                    bin.1 += 1;
+                }
+            }
+        }
+        let ratio = (high.0 / high.1 as f64) / (low.0 / low.1 as f64);
+        assert!(ratio > 1.5, "{what}: high/low mean edge ratio {ratio:.2}");
+    }
     // Bad arrays, each in piece 1 (rank 1's).
     let out = dir.path().join("o.pvtu");
     let piece = pieces[1].file_name().unwrap().to_str().unwrap();
@@ -1755,9 +1816,12 @@ fn a_point_two_ranks_share_without_a_face_gets_one_global_id() {
     ];
     for (ranks, extra) in runs {
         let out = dir.path().join(format!("l{ranks}.pvtu"));
+        let stats = dir.path().join(format!("l{ranks}.json"));
         let mut args = vec!["refine", "meshes/getfem_ladder.vtu", "-o"];
         let o = s(&out);
+        let st = s(&stats);
         args.push(&o);
+        args.extend(["--stats", &st]);
         args.extend(extra);
         mpirun_ok(ranks, &args);
         let what = format!("-n {ranks} {extra:?}");
@@ -1766,6 +1830,7 @@ fn a_point_two_ranks_share_without_a_face_gets_one_global_id() {
         let mut holders: HashMap<[u64; 3], std::collections::BTreeSet<usize>> = HashMap::new();
         // Per face (sorted corner keys): the pieces holding it.
         let mut faces: HashMap<[[u64; 3]; 3], std::collections::BTreeSet<usize>> = HashMap::new();
+        let mut edges: std::collections::HashSet<[[u64; 3]; 2]> = Default::default();
         let sources = piece_sources(&out);
         assert_eq!(sources.len(), ranks as usize, "{what}");
         for (k, src) in sources.iter().enumerate() {
@@ -1785,6 +1850,11 @@ fn a_point_two_ranks_share_without_a_face_gets_one_global_id() {
                     let mut key = f.map(|i| coord_key(d.points[t[i] as usize]));
                     key.sort_unstable();
                     faces.entry(key).or_default().insert(k);
+                }
+                for (i, j) in [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)] {
+                    let mut key = [i, j].map(|i| coord_key(d.points[t[i] as usize]));
+                    key.sort_unstable();
+                    edges.insert(key);
                 }
             }
             for (v, p) in d.points.iter().enumerate().filter(|&(v, _)| used[v]) {
@@ -1818,6 +1888,19 @@ fn a_point_two_ranks_share_without_a_face_gets_one_global_id() {
         assert_eq!(
             two_ids, 0,
             "{what}: {pinches} pinches, {two_ids} points with two ids"
+        );
+        // The reported counts are the union's: a pinch point (edge) is one
+        // node (edge), not one per piece holding it.
+        let d = final_stats(&stats);
+        assert_eq!(
+            d["nodes"].as_u64().unwrap() as usize,
+            ids.len(),
+            "{what}: nodes"
+        );
+        assert_eq!(
+            d["edges"].as_u64().unwrap() as usize,
+            edges.len(),
+            "{what}: edges"
         );
         let all: std::collections::BTreeSet<i64> = ids.values().flatten().copied().collect();
         assert_eq!(all.len(), ids.len(), "{what}: one point per id");

@@ -51,10 +51,13 @@ struct StatsFile<'a> {
     seconds: f64,
 }
 
-/// Runs `refine` distributed.
-pub fn run(a: Args) -> super::CliResult {
-    let pieces = is_pvtu(&a.output);
-    let pvtu_in = super::pvtu_input::per_rank(&a);
+/// The checks of `a` made before any work (alike on every rank): the size
+/// plan and the marking strategy they yield.
+fn check_arguments(
+    a: &Args,
+    pieces: bool,
+    pvtu_in: bool,
+) -> Result<(super::size::Plan, Option<tetrefine::MarkStrategy>), String> {
     if !pieces {
         tetrefine::io::Format::for_writing(&a.output).map_err(|e| e.to_string())?;
     }
@@ -62,8 +65,7 @@ pub fn run(a: Args) -> super::CliResult {
     if let Some(f) = &a.features_out {
         tetrefine::PolylineFormat::of(f).map_err(|e| e.to_string())?;
     }
-    let plan = super::size::plan(&a)?;
-    let n_steps = plan.n_steps;
+    let plan = super::size::plan(a)?;
     if pvtu_in && a.size.is_some() {
         return Err(format!(
             "{} is read per rank (a .pvtu input with a .pvtu output), and --size numbers the points of one whole mesh: write a .vtu output (rank 0 reads the whole input), or give --size-array NAME (a point array of the pieces), --hsiz or --hmax",
@@ -73,9 +75,18 @@ pub fn run(a: Args) -> super::CliResult {
     if let Some(h) = &a.histogram {
         super::check_histogram_path(h)?;
     }
-    super::refine::check_numbers(&a)?;
-    let strategy = mark_strategy(&a)?;
+    super::refine::check_numbers(a)?;
+    Ok((plan, mark_strategy(a)?))
+}
+
+/// Runs `refine` distributed.
+pub fn run(a: Args) -> super::CliResult {
+    let pieces = is_pvtu(&a.output);
+    let pvtu_in = super::pvtu_input::per_rank(&a);
     let (_universe, comm) = dist::init()?;
+    // The arguments' checks fail alike on every rank: said once.
+    let (plan, strategy) = comm.agree_alike(check_arguments(&a, pieces, pvtu_in))?;
+    let n_steps = plan.n_steps;
     let t0 = Instant::now();
     let root = comm.rank == 0;
     let mut steps = Vec::new();
