@@ -298,23 +298,9 @@ fn band_zone(
         .map(|&p| frozen.contains(&part::point_key(p)))
         .collect();
     let refined = refined_only.then(|| descendants_of_last_step(mesh, step));
-    let mut tets = vec![false; mesh.n_tet_slots()];
-    let mut verts = on_cut;
-    for _ in 0..BAND_RINGS {
-        let mut next = verts.clone();
-        for t in mesh.tet_ids() {
-            let v = mesh.tet(t);
-            let allowed = refined.as_ref().is_none_or(|r| r[t as usize]);
-            if allowed && v.iter().any(|&x| verts[x as usize]) {
-                tets[t as usize] = true;
-                for x in v {
-                    next[x as usize] = true;
-                }
-            }
-        }
-        verts = next;
-    }
-    (verts, tets)
+    mesh.grow_zone(on_cut, BAND_RINGS, |t| {
+        refined.as_ref().is_none_or(|r| r[t as usize])
+    })
 }
 
 /// Before an adaptive step: a partition face whose tet on the other rank

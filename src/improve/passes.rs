@@ -252,22 +252,13 @@ impl Tracker {
         }
     }
 
-    /// The worst quality of the live tets that may change (+∞ if none).
-    fn worst_allowed(&self, mesh: &TetMesh) -> f64 {
+    /// The worst quality of the live tets, of those that may change only
+    /// with `allowed_only` (+∞ if none).
+    fn worst(&self, mesh: &TetMesh, allowed_only: bool) -> f64 {
         (0..mesh.n_tet_slots() as u32)
             .into_par_iter()
             .with_min_len(4096)
-            .filter(|&t| mesh.is_alive(t) && self.is_allowed(t))
-            .map(|t| self.tq[t as usize])
-            .reduce(|| f64::INFINITY, f64::min)
-    }
-
-    /// The worst quality of all live tets (+∞ if none).
-    fn worst_live(&self, mesh: &TetMesh) -> f64 {
-        (0..mesh.n_tet_slots() as u32)
-            .into_par_iter()
-            .with_min_len(4096)
-            .filter(|&t| mesh.is_alive(t))
+            .filter(|&t| mesh.is_alive(t) && (!allowed_only || self.is_allowed(t)))
             .map(|t| self.tq[t as usize])
             .reduce(|| f64::INFINITY, f64::min)
     }
@@ -326,15 +317,16 @@ pub fn improve(mesh: &mut TetMesh, opts: &ImproveOptions) -> ImproveReport {
     // bar, never below the worst of the mesh as it came in (the floor then
     // rises to that worst): on a mesh already above the bar, `improve`
     // would otherwise lower its worst tet.
-    let raised;
-    let opts = if opts.smooth_for_mean {
-        raised = ImproveOptions {
-            floor: opts.floor.max(tr.worst_live(mesh)),
-            ..opts.clone()
-        };
-        &raised
+    let floor = if opts.smooth_for_mean {
+        opts.floor.max(tr.worst(mesh, false))
     } else {
-        opts
+        opts.floor
+    };
+    // What a move for the mean must keep its ball above.
+    let keep = if opts.smooth_for_mean {
+        opts.threshold.max(floor)
+    } else {
+        f64::INFINITY
     };
     let mut edges = EdgeRemoval::default();
     // Caps go before the smoother takes the boundary as its reference, and
@@ -351,8 +343,8 @@ pub fn improve(mesh: &mut TetMesh, opts: &ImproveOptions) -> ImproveReport {
     let mut worst = f64::NEG_INFINITY;
     for pass in 0..opts.passes + FLOOR_PASSES {
         if pass >= opts.passes {
-            let now = tr.worst_allowed(mesh);
-            if now >= opts.floor || now <= worst {
+            let now = tr.worst(mesh, true);
+            if now >= floor || now <= worst {
                 break;
             }
             worst = now;
@@ -366,7 +358,7 @@ pub fn improve(mesh: &mut TetMesh, opts: &ImproveOptions) -> ImproveReport {
         if opts.insert_vertices && pass >= INSERT_FROM_PASS {
             changed += insert_pass(mesh, &mut tr, &mut movable, &mut zone, opts, &mut report);
         }
-        changed += smooth_pass(mesh, &mut tr, &movable, opts, &mut report);
+        changed += smooth_pass(mesh, &mut tr, &movable, opts, keep, &mut report);
         if let Some(s) = &surface {
             changed += boundary_pass(mesh, &mut tr, s, opts, &mut report);
         }
@@ -387,7 +379,7 @@ pub fn improve(mesh: &mut TetMesh, opts: &ImproveOptions) -> ImproveReport {
             if merged > 0 {
                 edges.pass(mesh, &mut tr, opts, &mut report);
                 contract_pass(mesh, &mut tr, &mut movable, None, opts, &mut report);
-                smooth_pass(mesh, &mut tr, &movable, opts, &mut report);
+                smooth_pass(mesh, &mut tr, &movable, opts, keep, &mut report);
             }
             cap_pass(mesh, &mut tr, b, opts, &mut report);
             // Flips go last: before the smoother, a flip's new faces would
@@ -1153,6 +1145,7 @@ fn smooth_vertex(
     v: u32,
     ball: &[u32],
     opts: &ImproveOptions,
+    keep: f64,
     s: &mut SmoothScratch,
 ) -> Option<VertexMove> {
     let mut q = f64::INFINITY;
@@ -1173,11 +1166,7 @@ fn smooth_vertex(
         worst: q,
         mean,
         first: worst,
-        keep: if opts.smooth_for_mean {
-            opts.threshold.max(opts.floor)
-        } else {
-            f64::INFINITY
-        },
+        keep,
     };
     s.ball.load(mesh, v, ball);
     if let Some((x2, q2)) = laplacian_position_in(mesh, v, ball, &s.ball, now, &mut s.qualities) {
@@ -1223,6 +1212,7 @@ fn smooth_pass(
     tr: &mut Tracker,
     movable: &[bool],
     opts: &ImproveOptions,
+    keep: f64,
     report: &mut ImproveReport,
 ) -> usize {
     let mut vq = vec![f64::INFINITY; mesh.n_points()];
@@ -1280,7 +1270,15 @@ fn smooth_pass(
         }
         drop(classes);
         for group in &groups {
-            let moves = decide_moves(mesh, &tr.tq, &balls, block, group, opts, &mut scratch);
+            let moves = decide_moves(
+                mesh,
+                &tr.tq,
+                &balls,
+                block,
+                group,
+                (opts, keep),
+                &mut scratch,
+            );
             moved += apply_moves(mesh, tr, &balls, block, group, moves, report);
         }
     }
@@ -1344,14 +1342,15 @@ fn apply_moves(
 }
 
 /// The moves [`smooth_vertex`] decides for the vertices of balls `group`
-/// (no two sharing a tet), in parallel if there are enough of them.
+/// (no two sharing a tet), in parallel if there are enough of them; a
+/// move for the mean keeps its ball above `keep`.
 fn decide_moves(
     mesh: &TetMesh,
     tq: &[f64],
     balls: &Balls,
     verts: &[u32],
     group: &[u32],
-    opts: &ImproveOptions,
+    (opts, keep): (&ImproveOptions, f64),
     scratch: &mut SmoothScratch,
 ) -> Vec<Option<VertexMove>> {
     let one = |s: &mut SmoothScratch, i: u32| {
@@ -1359,7 +1358,7 @@ fn decide_moves(
         if ball.is_empty() {
             return None;
         }
-        smooth_vertex(mesh, tq, verts[i as usize], ball, opts, s)
+        smooth_vertex(mesh, tq, verts[i as usize], ball, opts, keep, s)
     };
     if group.len() < 64 {
         // Not worth a trip through the thread pool.

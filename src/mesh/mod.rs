@@ -722,6 +722,35 @@ impl TetMesh {
         }
     }
 
+    /// A zone grown from the vertices `seeds` (per point) by `rings` rings
+    /// of tets: each ring takes every live tet `through` admits with a
+    /// vertex in the zone, and that tet's vertices. Returns the zone's
+    /// vertices (per point) and tets (per tet slot).
+    pub(crate) fn grow_zone(
+        &self,
+        seeds: Vec<bool>,
+        rings: usize,
+        through: impl Fn(u32) -> bool,
+    ) -> (Vec<bool>, Vec<bool>) {
+        assert_eq!(seeds.len(), self.n_points(), "one seed flag per point");
+        let mut tets = vec![false; self.n_tet_slots()];
+        let mut verts = seeds;
+        for _ in 0..rings {
+            let mut next = verts.clone();
+            for t in self.tet_ids() {
+                let v = self.tet(t);
+                if through(t) && v.iter().any(|&x| verts[x as usize]) {
+                    tets[t as usize] = true;
+                    for x in v {
+                        next[x as usize] = true;
+                    }
+                }
+            }
+            verts = next;
+        }
+        (verts, tets)
+    }
+
     /// The tets around vertex `v` (its ball), found by walking face adjacency
     /// from one incident tet; appended to `out` (cleared first).
     pub fn ball(&self, v: u32, out: &mut Vec<u32>) {

@@ -303,26 +303,17 @@ fn rescue_options(
     if bad.is_empty() {
         return None;
     }
-    // The bad tets' vertices, then every vertex of their balls.
+    // The bad tets' vertices, then every tet and vertex of their balls
+    // (grown through any tet; the zone's limits apply after).
     let mut near = vec![false; mesh.n_points()];
     for &t in &bad {
         for v in mesh.tet(t) {
             near[v as usize] = true;
         }
     }
-    let mut tets = vec![false; mesh.n_tet_slots()];
-    for t in mesh.tet_ids() {
-        if mesh.tet(t).iter().any(|&v| near[v as usize]) {
-            tets[t as usize] = true;
-        }
-    }
-    let mut movable = vec![false; mesh.n_points()];
-    for t in mesh.tet_ids() {
-        if tets[t as usize] {
-            for v in mesh.tet(t) {
-                movable[v as usize] = zone_movable.as_ref().is_none_or(|m| m[v as usize]);
-            }
-        }
+    let (mut movable, mut tets) = mesh.grow_zone(near, 1, |_| true);
+    if let Some(m) = &zone_movable {
+        movable.iter_mut().zip(m).for_each(|(x, &z)| *x &= z);
     }
     for t in mesh.tet_ids() {
         tets[t as usize] &= allowed(t);

@@ -768,8 +768,22 @@ fn children_of(parent: i32, exe: Option<&Path>) -> Vec<i32> {
     out
 }
 
+/// Whether process `pid` catches `signal` (its `SigCgt` mask in
+/// `/proc/PID/status`); false once it is gone.
+fn catches(pid: i32, signal: i32) -> bool {
+    let Ok(status) = std::fs::read_to_string(format!("/proc/{pid}/status")) else {
+        return false;
+    };
+    status
+        .lines()
+        .find_map(|l| l.strip_prefix("SigCgt:"))
+        .and_then(|m| u64::from_str_radix(m.trim(), 16).ok())
+        .is_some_and(|mask| mask & (1u64 << (signal - 1)) != 0)
+}
+
 /// Waits for a child of `parent` (running `exe` if given) to appear and
-/// sends it `signal`; gives up when `done()` says the run ended first.
+/// sends it `signal` once it no longer catches it; gives up when `done()`
+/// says the run ended first.
 /// Whether a child was signalled.
 fn kill_child_of(
     parent: i32,
@@ -778,7 +792,14 @@ fn kill_child_of(
     mut done: impl FnMut() -> bool,
 ) -> bool {
     loop {
-        if let Some(&pid) = children_of(parent, exe).first() {
+        // A forked child still catches `signal` with the parent's handler
+        // until it sets its own dispositions (Rust's runtime catches
+        // SIGSEGV, and its handler lets one sent by `kill` pass): wait for
+        // the child to stop catching it, or the signal can be lost.
+        if let Some(&pid) = children_of(parent, exe)
+            .iter()
+            .find(|&&pid| !catches(pid, signal))
+        {
             // SAFETY: kill has no memory preconditions; `pid` is a child of
             // `parent` that is still running or a zombie (not yet reaped).
             unsafe { libc::kill(pid, signal) };
