@@ -252,6 +252,55 @@ impl Tracker {
         }
     }
 
+    /// Whether vertex `v` is dirty (its ball changed since it was last
+    /// looked at).
+    fn is_dirty(&self, v: usize) -> bool {
+        self.vert_dirty[v].load(std::sync::atomic::Ordering::Relaxed)
+    }
+
+    /// Per point, the worst quality of its live tets, for the points
+    /// `wanted` names (+∞ for the others, and for a point without tets).
+    /// Few wanted points (a small zone in a large mesh: a rescue round, an
+    /// adaptive step's `--smooth refined`) walk their balls; many sweep the
+    /// tets once. Both take the minimum over the same tets.
+    fn worst_at(&self, mesh: &TetMesh, wanted: impl Fn(usize) -> bool) -> Vec<f64> {
+        let n = mesh.n_points();
+        let mut vq = vec![f64::INFINITY; n];
+        let few: Vec<usize> = {
+            let mut few = Vec::new();
+            for v in 0..n {
+                if wanted(v) {
+                    few.push(v);
+                    if few.len() > n / 32 {
+                        break;
+                    }
+                }
+            }
+            few
+        };
+        if few.len() <= n / 32 {
+            let mut ball = Vec::new();
+            for v in few {
+                mesh.ball(v as u32, &mut ball);
+                vq[v] = ball
+                    .iter()
+                    .map(|&t| self.tq[t as usize])
+                    .fold(f64::INFINITY, f64::min);
+            }
+            return vq;
+        }
+        for (t, tv) in mesh.tet_slots().iter().enumerate() {
+            let q = self.tq[t];
+            if q.is_finite() && mesh.is_alive(t as u32) {
+                for &x in tv {
+                    let s = &mut vq[x as usize];
+                    *s = s.min(q);
+                }
+            }
+        }
+        vq
+    }
+
     /// The worst quality of the live tets, of those that may change only
     /// with `allowed_only` (+∞ if none).
     fn worst(&self, mesh: &TetMesh, allowed_only: bool) -> f64 {
@@ -771,27 +820,18 @@ fn boundary_pass(
     report: &mut ImproveReport,
 ) -> usize {
     let bar = opts.threshold.max(opts.laplacian_threshold);
-    let mut vq = vec![f64::INFINITY; mesh.n_points()];
-    for (t, tv) in mesh.tet_slots().iter().enumerate() {
-        let q = tr.tq[t];
-        if q.is_finite() && mesh.is_alive(t as u32) {
-            for &x in tv {
-                let s = &mut vq[x as usize];
-                *s = s.min(q);
-            }
-        }
-    }
+    let may = |v: usize| {
+        opts.movable
+            .as_ref()
+            .is_none_or(|m| m.get(v).copied().unwrap_or(false))
+    };
+    let vq = tr.worst_at(mesh, |v| tr.is_dirty(v) && may(v));
     let verts: Vec<u32> = s
         .movable_vertices()
         .into_iter()
         .filter(|&v| {
             let dirty = tr.vert_dirty[v as usize].get_mut();
-            let take = *dirty
-                && vq[v as usize] < bar
-                && opts
-                    .movable
-                    .as_ref()
-                    .is_none_or(|m| m.get(v as usize).copied().unwrap_or(false));
+            let take = *dirty && vq[v as usize] < bar && may(v as usize);
             if take {
                 *dirty = false;
             }
@@ -1215,16 +1255,7 @@ fn smooth_pass(
     keep: f64,
     report: &mut ImproveReport,
 ) -> usize {
-    let mut vq = vec![f64::INFINITY; mesh.n_points()];
-    for (t, tv) in mesh.tet_slots().iter().enumerate() {
-        let q = tr.tq[t];
-        if q.is_finite() && mesh.is_alive(t as u32) {
-            for &x in tv {
-                let s = &mut vq[x as usize];
-                *s = s.min(q);
-            }
-        }
-    }
+    let vq = tr.worst_at(mesh, |v| tr.is_dirty(v) && movable[v]);
     let bar = opts.threshold.max(opts.laplacian_threshold);
     let mut verts = Vec::new();
     let mut alone = Vec::new();
