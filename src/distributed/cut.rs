@@ -140,17 +140,11 @@ fn cut_keys(mesh: &TetMesh) -> CutKeys {
     let mut pts = std::collections::BTreeSet::new();
     let mut cut_pts = std::collections::BTreeSet::new();
     let mut edges = std::collections::BTreeSet::new();
-    for t in mesh.tet_ids() {
-        for f in 0..4 {
-            if mesh.adj(t)[f] != NO_ADJ {
-                continue;
-            }
-            let fv = mesh.face_vertices(t, f);
-            pts.extend(fv);
-            for i in 0..3 {
-                let (a, b) = (fv[i], fv[(i + 1) % 3]);
-                edges.insert(if a < b { [a, b] } else { [b, a] });
-            }
+    for fv in boundary_faces(mesh) {
+        pts.extend(fv);
+        for i in 0..3 {
+            let (a, b) = (fv[i], fv[(i + 1) % 3]);
+            edges.insert(if a < b { [a, b] } else { [b, a] });
         }
     }
     let faces = partition_faces(mesh);
@@ -398,15 +392,18 @@ fn gather_f64(comm: &Comm, x: f64) -> Result<f64, String> {
 /// non-manifold input, or a cut meeting itself, touches another part at a
 /// point or an edge only), which no partition face names.
 fn boundary_point_keys(mesh: &TetMesh) -> Vec<PointKey> {
-    let mut pts = std::collections::BTreeSet::new();
-    for t in mesh.tet_ids() {
-        for f in 0..4 {
-            if mesh.adj(t)[f] == NO_ADJ {
-                pts.extend(mesh.face_vertices(t, f));
-            }
-        }
-    }
+    let pts: std::collections::BTreeSet<u32> = boundary_faces(mesh).flatten().collect();
     pts.iter().map(|&v| point_key(mesh.point(v))).collect()
+}
+
+/// The vertices of every face of `mesh` without a neighbour (the domain's
+/// boundary and the cut).
+fn boundary_faces(mesh: &TetMesh) -> impl Iterator<Item = [u32; 3]> + '_ {
+    mesh.tet_ids().flat_map(move |t| {
+        (0..4)
+            .filter(move |&f| mesh.adj(t)[f] == NO_ADJ)
+            .map(move |f| mesh.face_vertices(t, f))
+    })
 }
 
 /// Global point ids: each shared point belongs to the lowest rank holding

@@ -825,7 +825,7 @@ fn boundary_pass(
             .as_ref()
             .is_none_or(|m| m.get(v).copied().unwrap_or(false))
     };
-    let vq = tr.worst_at(mesh, |v| tr.is_dirty(v) && may(v));
+    let vq = tr.worst_at(mesh, |v| s.is_movable(v as u32) && tr.is_dirty(v) && may(v));
     let verts: Vec<u32> = s
         .movable_vertices()
         .into_iter()

@@ -203,8 +203,8 @@ pub(crate) fn optimize_phase(
     if opts.opt_passes == 0 {
         return crate::improve::ImproveReport::default();
     }
-    let frozen_band = zone.is_some();
-    // The band's rescue (below) needs its points after the passes.
+    // The distributed band's rescue (below) needs its points after the
+    // passes.
     let band = zone.as_ref().map(|(verts, _)| verts.clone());
     let (movable, tet_allowed) = match zone {
         Some((verts, tets)) => (Some(verts), Some(tets)),
@@ -225,7 +225,7 @@ pub(crate) fn optimize_phase(
             opts.hausd,
         )
     };
-    if frozen_band {
+    if band.is_some() {
         // The band had only the first passes, without its interface
         // vertices: it gets the settling round's edge-removal bar.
         io.edge_threshold = io.edge_threshold.max(SETTLE_EDGE_THRESHOLD);
@@ -273,20 +273,8 @@ pub(crate) fn optimize_phase(
         for t in mesh.tet_ids() {
             tets[t as usize] = mesh.tet(t).iter().all(|&v| verts[v as usize]);
         }
-        let t0 = std::time::Instant::now();
         if let Some(rescue) = rescue_options(mesh, Some(verts), Some(tets), opts, bar) {
-            let t1 = std::time::Instant::now();
-            let nz = rescue
-                .tet_allowed
-                .as_ref()
-                .map_or(0, |a| a.iter().filter(|&&x| x).count());
-            let r = improve(mesh, &rescue);
-            eprintln!(
-                "DBG band rescue: zone {nz} tets, options {:.2}s, improve {:.2}s",
-                (t1 - t0).as_secs_f64(),
-                t1.elapsed().as_secs_f64()
-            );
-            report.add(&r);
+            report.add(&improve(mesh, &rescue));
         }
         return report;
     }
