@@ -1930,3 +1930,154 @@ fn pieces_whose_cut_has_moved_read_per_rank_step_as_the_serial_mesh_with_their_c
         assert_eq!(got, serial_on_pieces_with_their_cut(&a, 1), "{name}");
     }
 }
+
+/// The smallest dihedral angle of the tet with corners `p`, in degrees,
+/// from the face normals at each edge: `e × (pk − pi)` and `e × (pl − pi)`
+/// are the two faces' in-plane directions off edge `e = pj − pi`, each
+/// turned a quarter about `e`, so the angle between them is the dihedral
+/// angle.
+fn min_dihedral_deg(p: [glam::DVec3; 4]) -> f64 {
+    let mut min = f64::INFINITY;
+    for (i, j, k, l) in [
+        (0, 1, 2, 3),
+        (0, 2, 1, 3),
+        (0, 3, 1, 2),
+        (1, 2, 0, 3),
+        (1, 3, 0, 2),
+        (2, 3, 0, 1),
+    ] {
+        let e = p[j] - p[i];
+        let (n1, n2) = (e.cross(p[k] - p[i]), e.cross(p[l] - p[i]));
+        let c = n1.dot(n2) / (n1.length() * n2.length());
+        min = min.min(c.clamp(-1.0, 1.0).acos().to_degrees());
+    }
+    min
+}
+
+/// An adaptive run whose selection is a fifth of the tripod, at one end,
+/// refined twice on 2 ranks: METIS weighs each selected tet by what it
+/// grows into, so the ranks end the steps with shares within a quarter of
+/// each other (with every tet weighing one, the rank holding the selection
+/// would hold nearly all of its 36k descendants against the other's
+/// ~1.4k input tets). Then the same run to the end, cut move included:
+/// `--stats` (reduced across ranks) gives the union's counts and its
+/// histogram of the minimum dihedral angle as this test bins the union's
+/// tets itself, and the progress table is printed once (by rank 0).
+#[test]
+fn an_adaptive_run_is_balanced_and_its_statistics_are_the_unions() {
+    let dir = tempfile::tempdir().unwrap();
+    let name = "meshes/tripod.mesh";
+    let select = ["--box", "-100,-100,-100,100,0,100", "--steps", "2"];
+    let mesh_in = input(name);
+    // The box holds the tets whose vertices all have y <= 0 (at least).
+    let below = mesh_in
+        .tet_ids()
+        .filter(|&t| mesh_in.tet_points(t).iter().all(|p| p.y <= 0.0))
+        .count();
+    assert!(
+        below * 10 > mesh_in.n_tets() && below * 4 < mesh_in.n_tets(),
+        "the fixture selects a tenth to a quarter: {below} of {}",
+        mesh_in.n_tets()
+    );
+    let out = dir.path().join("steps.pvtu");
+    let mut args = vec!["refine", name, "-o", out.to_str().unwrap()];
+    args.extend(select);
+    args.extend(["--stop-after", "optimize"]);
+    mpirun_ok(2, &args);
+    let (union, owner) = union_with_owners(&out);
+    let share = [0, 1].map(|r| owner.iter().filter(|&&o| o == r).count());
+    assert_eq!(share[0] + share[1], union.n_tets());
+    let (lo, hi) = (share[0].min(share[1]), share[0].max(share[1]));
+    assert!(
+        hi * 4 <= lo * 5,
+        "rank shares {share:?} of {} tets",
+        union.n_tets()
+    );
+    assert!(union.n_tets() > 8 * mesh_in.n_tets(), "the selection grew");
+
+    let out = dir.path().join("end.pvtu");
+    let stats = dir.path().join("end.json");
+    let mut args = vec!["refine", name, "-o", out.to_str().unwrap()];
+    args.extend(select);
+    args.extend(["--stats", stats.to_str().unwrap()]);
+    let run = mpirun_ok(2, &args);
+    // Progress comes from rank 0 alone: each row of the table (standard
+    // output) and each message (standard error) once.
+    let (out_text, err) = (
+        String::from_utf8_lossy(&run.stdout),
+        String::from_utf8_lossy(&run.stderr),
+    );
+    for (text, row) in [
+        (&out_text, "input "),
+        (&out_text, "step 1 "),
+        (&out_text, "step 2 "),
+        (&out_text, "cut "),
+        (&err, "selected "),
+        (&err, "cut move 1/"),
+        (&err, "wrote "),
+    ] {
+        let n = text.lines().filter(|l| l.starts_with(row)).count();
+        assert_eq!(n, 1, "{row:?} printed {n} times:\n{text}");
+    }
+    let (union, _) = union_of_pieces(&out);
+    let d = final_stats(&stats);
+    let boundary_faces: usize = union
+        .tet_ids()
+        .map(|t| (0..4).filter(|&f| union.adj(t)[f] == NO_ADJ).count())
+        .sum();
+    assert_eq!(d["tets"].as_u64(), Some(union.n_tets() as u64));
+    assert_eq!(d["nodes"].as_u64(), Some(union.n_points() as u64));
+    assert_eq!(d["boundary_faces"].as_u64(), Some(boundary_faces as u64));
+    let mut edges: Vec<[u32; 2]> = union
+        .tet_ids()
+        .flat_map(|t| {
+            let v = union.tet(t);
+            [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)]
+                .map(|(i, j)| [v[i].min(v[j]), v[i].max(v[j])])
+        })
+        .collect();
+    edges.sort_unstable();
+    edges.dedup();
+    assert_eq!(d["edges"].as_u64(), Some(edges.len() as u64));
+    let angles: Vec<f64> = union
+        .tet_ids()
+        .map(|t| min_dihedral_deg(union.tet_points(t)))
+        .collect();
+    let h = &d["histogram"];
+    let lo_edges: Vec<f64> = h["edges_deg"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_f64().unwrap())
+        .collect();
+    let counts: Vec<u64> = h["counts"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_u64().unwrap())
+        .collect();
+    assert_eq!(lo_edges.len(), counts.len() + 1);
+    assert_eq!(counts.iter().sum::<u64>(), union.n_tets() as u64);
+    for (b, &c) in counts.iter().enumerate() {
+        let (a, z) = (lo_edges[b], lo_edges[b + 1]);
+        // A tet within rounding of a bin edge may fall on either side.
+        let sure = angles
+            .iter()
+            .filter(|&&x| x >= a + 1e-9 && x < z - 1e-9)
+            .count() as u64;
+        let maybe = angles
+            .iter()
+            .filter(|&&x| x >= a - 1e-9 && x < z + 1e-9)
+            .count() as u64;
+        assert!(
+            (sure..=maybe).contains(&c),
+            "bin {a}–{z}°: {c} tets, the union has {sure}–{maybe}"
+        );
+    }
+    let worst = angles.iter().copied().fold(f64::INFINITY, f64::min);
+    let worst_stats = d["min_dihedral_deg"]["worst"].as_f64().unwrap();
+    assert!(
+        (worst - worst_stats).abs() < 1e-9,
+        "{worst} vs {worst_stats}"
+    );
+}
