@@ -21,7 +21,9 @@
 //! move is for.
 
 use super::cut::{all_holders_agree, edge_coords};
-use super::{census, global_stats, migrate_cut_layer, Census, Comm, LocalMesh, CUT_LAYERS};
+use super::{
+    census, global_stats, migrate_cut_layer, rebalance_and_say, Census, Comm, LocalMesh, CUT_LAYERS,
+};
 use crate::improve::ImproveOptions;
 use crate::mesh::partition::PartitionMarker;
 use crate::mesh::TetMesh;
@@ -137,6 +139,11 @@ pub fn size_distributed(
             if done && (opts.until_met || after_cut_move) {
                 break;
             }
+        }
+    }
+    if comm.size > 1 && SIZE_CUT_MOVES > 0 {
+        if let (Some((c, stats)), Some(l)) = (rebalance_and_say(comm, local)?, last.as_mut()) {
+            (l.0, l.1) = (c, stats);
         }
     }
     match last {

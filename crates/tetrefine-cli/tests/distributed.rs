@@ -2081,3 +2081,38 @@ fn an_adaptive_run_is_balanced_and_its_statistics_are_the_unions() {
         "{worst} vs {worst_stats}"
     );
 }
+
+/// After the cut move, which carries its layers to the lower rank
+/// (gmsh_t16, one step on 3 ranks: 62,258 / 42,478 / 18,704 tets before
+/// the rebalance), each rank's piece is within a fifth of the mean, the
+/// union still one conforming mesh with the input's volume and boundary.
+#[test]
+fn pieces_are_rebalanced_after_the_cut_move() {
+    let dir = tempfile::tempdir().unwrap();
+    let name = "meshes/gmsh_t16.mesh";
+    let (vol_in, area_in) = measures(&input(name));
+    let out = dir.path().join("r.pvtu");
+    let run = mpirun_ok(
+        3,
+        &[
+            "refine",
+            name,
+            "-o",
+            out.to_str().unwrap(),
+            "--boundary",
+            "linear",
+        ],
+    );
+    let err = String::from_utf8_lossy(&run.stderr);
+    assert_eq!(err.matches("rebalanced:").count(), 1, "{err}");
+    let (union, owner) = union_with_owners(&out);
+    assert_measures_kept("rebalanced", &union, &vol_in, area_in);
+    let mean = union.n_tets() as f64 / 3.0;
+    for r in 0..3 {
+        let n = owner.iter().filter(|&&o| o == r).count() as f64;
+        assert!(
+            (n - mean).abs() <= 0.2 * mean,
+            "rank {r}: {n} tets, mean {mean}"
+        );
+    }
+}
