@@ -2044,18 +2044,16 @@ fn an_adaptive_run_is_balanced_and_its_statistics_are_the_unions() {
         .map(|t| min_dihedral_deg(union.tet_points(t)))
         .collect();
     let h = &d["histogram"];
-    let lo_edges: Vec<f64> = h["edges_deg"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|x| x.as_f64().unwrap())
-        .collect();
-    let counts: Vec<u64> = h["counts"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|x| x.as_u64().unwrap())
-        .collect();
+    let numbers = |key: &str| -> Vec<f64> {
+        h[key]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|x| x.as_f64().unwrap())
+            .collect()
+    };
+    let lo_edges = numbers("edges_deg");
+    let counts: Vec<u64> = numbers("counts").into_iter().map(|c| c as u64).collect();
     assert_eq!(lo_edges.len(), counts.len() + 1);
     assert_eq!(counts.iter().sum::<u64>(), union.n_tets() as u64);
     for (b, &c) in counts.iter().enumerate() {
