@@ -21,7 +21,7 @@
 //!    vertices, so the old cut lies inside a part with a free layer before
 //!    the new cut, and the optimize phase runs again over the band the old
 //!    cut froze, with only the new cut frozen. Then ranks above the mean
-//!    share give whole layers to neighbours below it ([`rebalance`]).
+//!    share give whole layers to neighbours below it (the rebalance).
 //! 4. **Census.** After each step the ranks check that the cut conforms
 //!    (every partition face held by exactly two ranks), reduce the
 //!    statistics of the union ([`global_stats`]) and, at the end, number
@@ -506,13 +506,13 @@ pub(crate) fn rebalance_and_say(
 
 /// The shares of tets per rank before and after [`rebalance`].
 #[derive(Clone, Debug, PartialEq, Eq)]
-pub struct Rebalanced {
+pub(crate) struct Rebalanced {
     /// Tets per rank before.
-    pub before: Vec<u64>,
+    pub(crate) before: Vec<u64>,
     /// Tets per rank after.
-    pub after: Vec<u64>,
+    pub(crate) after: Vec<u64>,
     /// Tets that changed rank.
-    pub moved: u64,
+    pub(crate) moved: u64,
 }
 
 /// Evens out the ranks' shares once the cut has moved. Every move carries
