@@ -236,12 +236,14 @@ pub fn refine_distributed(
     if opts.improve_across_cut && comm.size > 1 && opts.steps > 0 {
         let mut o = opts.refine.clone();
         o.selection = None;
+        let mut changed = false;
         for k in 1..=CUT_MOVES {
             let t0 = std::time::Instant::now();
             let frozen = cut_point_keys(&local.mesh);
             if !migrate_cut_layer(comm, local, CUT_LAYERS)? {
                 break;
             }
+            changed = true;
             let t1 = std::time::Instant::now();
             let zone = band_zone(
                 &local.mesh,
@@ -258,8 +260,6 @@ pub fn refine_distributed(
                 Some(zone),
                 0.0,
             );
-            let c = census(comm, &local.mesh)?;
-            last = Some((c, global_stats(comm, &local.mesh, &c)?));
             let band = comm.sum(&[band])[0];
             if comm.rank == 0 {
                 eprintln!(
@@ -269,8 +269,12 @@ pub fn refine_distributed(
                 );
             }
         }
-        if let Some(c) = rebalance_and_say(comm, local)? {
-            last = Some(c);
+        changed |= rebalance_and_say(comm, local)?;
+        // The census and statistics of the mesh as the moves and the
+        // rebalance leave it, taken once.
+        if changed {
+            let c = census(comm, &local.mesh)?;
+            last = Some((c, global_stats(comm, &local.mesh, &c)?));
         }
     }
     match last {
@@ -479,18 +483,13 @@ fn migrate(comm: &Comm, local: &mut LocalMesh, dest: Vec<u32>) -> Result<bool, S
     Ok(true)
 }
 
-/// [`rebalance`], with a line from rank 0 saying what moved, and the
-/// census and statistics of the mesh when it changed.
-pub(crate) fn rebalance_and_say(
-    comm: &Comm,
-    local: &mut LocalMesh,
-) -> Result<Option<(Census, MeshStats)>, String> {
+/// [`rebalance`], with a line from rank 0 saying what moved. Returns
+/// whether tets moved (the caller's census and statistics are then stale).
+pub(crate) fn rebalance_and_say(comm: &Comm, local: &mut LocalMesh) -> Result<bool, String> {
     let t0 = std::time::Instant::now();
     let Some(r) = rebalance(comm, local)? else {
-        return Ok(None);
+        return Ok(false);
     };
-    let c = census(comm, &local.mesh)?;
-    let stats = global_stats(comm, &local.mesh, &c)?;
     if comm.rank == 0 {
         let list = |v: &[u64]| v.iter().map(u64::to_string).collect::<Vec<_>>().join(" / ");
         eprintln!(
@@ -501,7 +500,7 @@ pub(crate) fn rebalance_and_say(
             t0.elapsed().as_secs_f64()
         );
     }
-    Ok(Some((c, stats)))
+    Ok(true)
 }
 
 /// The shares of tets per rank before and after [`rebalance`].
@@ -602,11 +601,8 @@ pub(crate) fn rebalance(comm: &Comm, local: &mut LocalMesh) -> Result<Option<Reb
             }
         }
     }
-    let moved = comm.sum(&[dest
-        .iter()
-        .enumerate()
-        .filter(|&(t, &d)| d != comm.rank && mesh.is_alive(t as u32))
-        .count() as u64])[0];
+    // A dead slot keeps this rank: only live tets were given.
+    let moved = comm.sum(&[dest.iter().filter(|&&d| d != comm.rank).count() as u64])[0];
     if moved == 0 || !migrate(comm, local, dest)? {
         return Ok(None);
     }

@@ -141,9 +141,10 @@ pub fn size_distributed(
             }
         }
     }
-    if comm.size > 1 && SIZE_CUT_MOVES > 0 {
-        if let (Some((c, stats)), Some(l)) = (rebalance_and_say(comm, local)?, last.as_mut()) {
-            (l.0, l.1) = (c, stats);
+    if comm.size > 1 && rebalance_and_say(comm, local)? {
+        if let Some(l) = last.as_mut() {
+            l.0 = census(comm, &local.mesh)?;
+            l.1 = global_stats(comm, &local.mesh, &l.0)?;
         }
     }
     match last {

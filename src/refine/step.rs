@@ -266,8 +266,7 @@ pub(crate) fn optimize_phase(
     // band's (the passes' flips made new tets of its vertices). Measured
     // on a 2.4M-tet MMG mesh of the tripod, one step on 2 ranks: the band
     // left 18.43° against the serial run's 20.30°.
-    if let Some(verts) = band {
-        let mut verts = verts;
+    if let Some(mut verts) = band {
         verts.resize(mesh.n_points(), false);
         let mut tets = vec![false; mesh.n_tet_slots()];
         for t in mesh.tet_ids() {
