@@ -136,33 +136,37 @@ pub fn tet_quality(p: &[DVec3; 4]) -> TetQuality {
 ///
 /// With `D` six times the signed volume, `sin θ_ij = D |e_ij| / (|n_k| |n_l|)`,
 /// so the minimum over the edges is `D · sqrt(min_ij |e_ij|² / (|n_k|² |n_l|²))`
-/// for `D > 0` (the max for `D < 0`): one square root instead of ten.
+/// for `D > 0` (the max for `D < 0`): one square root instead of ten. Edge
+/// `ij` lies on the faces opposite `k` and `l`, so with `N` the product of
+/// the four `|n|²`, `1 / (|n_k|² |n_l|²) = |n_i|² |n_j|² / N`: one division
+/// instead of four. `N` grows as the sixteenth power of the tet's size, so
+/// it stays a normal `f64` for edge lengths from 1e-19 to 1e19 — every
+/// unit a mesh is written in; a tet below that range reads as degenerate
+/// (quality 0), never as good.
 #[inline]
 pub fn tet_min_sine(p: &[DVec3; 4]) -> f64 {
     let n = face_normals(p);
-    let d = (p[1] - p[0]).dot((p[2] - p[0]).cross(p[3] - p[0]));
+    // n[3] = (p2 - p0) × (p1 - p0), so D = (p1 - p0) · ((p2 - p0) × (p3 - p0))
+    // = -(p3 - p0) · n[3].
+    let d = -(p[3] - p[0]).dot(n[3]);
     let n2 = [
         n[0].length_squared(),
         n[1].length_squared(),
         n[2].length_squared(),
         n[3].length_squared(),
     ];
-    if n2.contains(&0.0) {
-        return 0.0;
+    let all = n2[0] * n2[1] * n2[2] * n2[3];
+    if !all.is_normal() {
+        return if all.is_nan() { f64::NAN } else { 0.0 };
     }
-    let inv = [1.0 / n2[0], 1.0 / n2[1], 1.0 / n2[2], 1.0 / n2[3]];
     let mut lo = f64::INFINITY;
     let mut hi = 0.0f64;
-    for (&[i, j], &[k, l]) in TET_EDGES.iter().zip(TET_EDGE_OPPOSITE.iter()) {
-        let r = (p[j] - p[i]).length_squared() * inv[k] * inv[l];
+    for &[i, j] in TET_EDGES.iter() {
+        let r = (p[j] - p[i]).length_squared() * n2[i] * n2[j];
         lo = lo.min(r);
         hi = hi.max(r);
     }
-    if d >= 0.0 {
-        d * lo.sqrt()
-    } else {
-        d * hi.sqrt()
-    }
+    d * (if d >= 0.0 { lo } else { hi } / all).sqrt()
 }
 
 #[cfg(test)]
@@ -285,5 +289,22 @@ mod tests {
                     < 1e-9
             );
         }
+    }
+
+    /// The one-division form holds over the documented range of sizes:
+    /// the regular tet's 2√2/3 at edge lengths 1e-15 and 1e15, and a flat
+    /// tet reads 0.
+    #[test]
+    fn min_sine_is_scale_free_over_the_range() {
+        let p = positive(regular());
+        for s in [1e-15, 1e-6, 1.0, 1e6, 1e15] {
+            let q = p.map(|x| x * s);
+            assert!(
+                (tet_min_sine(&q) - 2.0 * 2f64.sqrt() / 3.0).abs() < 1e-12,
+                "{s}"
+            );
+        }
+        let flat = [DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::X + DVec3::Y];
+        assert_eq!(tet_min_sine(&flat), 0.0);
     }
 }

@@ -135,6 +135,31 @@ impl BallPoints {
         })
     }
 
+    /// The ODT target: the mean of the ball's tet circumcentres weighted
+    /// by the tets' volumes (`None` if the ball's volume is not positive).
+    ///
+    /// For a tet `a, b, c, d` with `u = b - a`, `v = c - a`, `w = d - a` and
+    /// `D = u · (v × w)`, the circumcentre is `a + m / (2D)` with
+    /// `m = |u|² v × w + |v|² w × u + |w|² u × v`, so `D` times it is
+    /// `D a + m / 2`: no division per tet, and a flat tet, whose
+    /// circumcentre runs off to infinity, adds its bounded `m / 2` (weight
+    /// zero times infinity done right).
+    pub fn odt_target(&self) -> Option<DVec3> {
+        let mut sum = DVec3::ZERO;
+        let mut vol = 0.0;
+        for p in &self.pts {
+            let a = p[0];
+            let (u, v, w) = (p[1] - a, p[2] - a, p[3] - a);
+            let det = u.dot(v.cross(w));
+            let num = u.length_squared() * v.cross(w)
+                + v.length_squared() * w.cross(u)
+                + w.length_squared() * u.cross(v);
+            sum += det * a + num * 0.5;
+            vol += det;
+        }
+        (vol > 0.0).then(|| sum / vol)
+    }
+
     /// Number of tets.
     pub fn len(&self) -> usize {
         self.pts.len()
