@@ -36,9 +36,10 @@ pub struct BallNow {
 /// Measured on the seven shipped meshes (one default step): the ODT target
 /// tried first raised the average minimum dihedral angle by 0.26°–0.75°
 /// (tripod 46.58° → 47.25°, the holed bar 47.13° → 47.88°) for up to a
-/// fifth more time (a quarter on cube grids); in place of the centroid it lowered it by 0.3°–2.2°
-/// (near the boundary the circumcentres of flat tets pull too far). The
-/// halfway point raised it by another 0.15°–0.9° (mmg_cube 43.0° → 43.9°).
+/// fifth more time (a quarter on cube grids); in place of the centroid it
+/// lowered it by 0.3°–2.2° (near the boundary the circumcentres of flat
+/// tets pull too far). The halfway point raised it by another 0.15°–0.9°
+/// (mmg_cube 43.0° → 43.9°).
 pub fn laplacian_position_in(
     mesh: &TetMesh,
     v: u32,

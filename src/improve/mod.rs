@@ -150,8 +150,9 @@ impl BallPoints {
         for p in &self.pts {
             let a = p[0];
             let (u, v, w) = (p[1] - a, p[2] - a, p[3] - a);
-            let det = u.dot(v.cross(w));
-            let num = u.length_squared() * v.cross(w)
+            let vw = v.cross(w);
+            let det = u.dot(vw);
+            let num = u.length_squared() * vw
                 + v.length_squared() * w.cross(u)
                 + w.length_squared() * u.cross(v);
             sum += det * a + num * 0.5;
