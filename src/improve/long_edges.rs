@@ -45,11 +45,15 @@ fn neighbours(mesh: &TetMesh, v: u32, ball: &mut Vec<u32>, out: &mut Vec<u32>) {
 /// id with the edge's length.
 type NeighbourBlock = (Vec<f64>, Vec<u32>, Vec<(u32, f64)>);
 
-/// The tets holding edge `(a, b)`, from the ball of `a`, ascending.
-fn shell(mesh: &TetMesh, a: u32, b: u32, out: &mut Vec<u32>) {
+/// The tets holding edge `(a, b)`, from the ball of `a`, ascending; returns
+/// the number of tets of the ball walked (all of `a`'s unless `a` is a
+/// pinch: tets at `a` that are not face-connected around it).
+fn shell(mesh: &TetMesh, a: u32, b: u32, out: &mut Vec<u32>) -> usize {
     mesh.ball(a, out);
+    let walked = out.len();
     out.retain(|&t| mesh.tet(t).contains(&b));
     out.sort_unstable();
+    walked
 }
 
 /// Whether no face of the shell holding `(a, b)` is constrained
@@ -74,6 +78,9 @@ struct LongEdge {
     length: f64,
     a: u32,
     b: u32,
+    /// Whether the walk that found its shell reached every tet at `a`
+    /// (see the loop in [`split_long_edges`]).
+    whole_ball: bool,
     /// Whether its split at the midpoint would be kept ([`split_is_kept`]).
     kept: bool,
     /// Its shell as found: a range of the list of (slot, generation).
@@ -130,6 +137,12 @@ pub(crate) fn split_long_edges(
     }
     let n = mesh.n_points() as u32;
     let fixed = mesh.fixed_vertices();
+    let mut tets_at = vec![0u32; n as usize];
+    for t in mesh.tet_ids() {
+        for v in mesh.tet(t) {
+            tets_at[v as usize] += 1;
+        }
+    }
     // One ball walk per vertex: its mean edge length, and its neighbours of
     // higher id with the edge's length (each edge once, at its lower end),
     // by blocks of vertices so that the lists stay in a few flat arrays.
@@ -189,7 +202,7 @@ pub(crate) fn split_long_edges(
                     for &(b, l) in &upper[from..end as usize] {
                         let local = 0.5 * (mean_len[a as usize] + mean_len[b as usize]);
                         if l > factor * local && !(fixed[a as usize] && fixed[b as usize]) {
-                            shell(mesh, a, b, sh);
+                            let walked = shell(mesh, a, b, sh);
                             if sh.iter().all(|&t| in_zone(zone, t)) && is_free_edge(mesh, a, b, sh)
                             {
                                 let start = shells.len();
@@ -198,6 +211,7 @@ pub(crate) fn split_long_edges(
                                     length: l,
                                     a,
                                     b,
+                                    whole_ball: walked == tets_at[a as usize] as usize,
                                     kept: split_is_kept(mesh, a, b, bar, sh),
                                     shell: start..shells.len(),
                                 });
@@ -236,10 +250,17 @@ pub(crate) fn split_long_edges(
         // one that held them, so one of these would be gone), and the
         // decision made on it stands. Otherwise an earlier split took the
         // edge or changed its shell: gather it again.
+        //
+        // At a pinch vertex the walk around `a` from its current tet may not
+        // reach the shell at all, and then the edge is left, as the walk
+        // alone decides: that case is always walked again. (A split keeps
+        // the pieces of every ball as they were, so a ball found whole
+        // stays whole.)
         let found = &shells[e.shell];
-        if found
-            .iter()
-            .all(|&(t, g)| mesh.is_alive(t) && mesh.generation(t) == g)
+        if e.whole_ball
+            && found
+                .iter()
+                .all(|&(t, g)| mesh.is_alive(t) && mesh.generation(t) == g)
         {
             if !e.kept {
                 continue;

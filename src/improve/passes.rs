@@ -468,29 +468,44 @@ fn face_pass(
     opts: &ImproveOptions,
     report: &mut ImproveReport,
 ) -> usize {
-    let found: Vec<Option<(usize, FacePlan)>> = {
+    // With each search result, the vertices across the faces of `t` as
+    // the search saw them (`NO_APEX` across the boundary).
+    const NO_APEX: u32 = u32::MAX;
+    type Found = (Option<(usize, FacePlan)>, [u32; 4]);
+    let found: Vec<Found> = {
         let (mesh, tr) = (&*mesh, &*tr);
         candidates
             .par_iter()
             .with_min_len(256)
             .map_init(FaceScratch::default, |s, &t| {
-                first_face_plan(mesh, tr, t, 0, movable, opts, s)
+                let plan = first_face_plan(mesh, tr, t, 0, movable, opts, s);
+                let apexes = if mesh.is_alive(t) {
+                    mesh.adj(t).map(|h| {
+                        if h == crate::mesh::NO_ADJ {
+                            NO_APEX
+                        } else {
+                            mesh.tet(h >> 2)[(h & 3) as usize]
+                        }
+                    })
+                } else {
+                    [NO_APEX; 4]
+                };
+                (plan, apexes)
             })
             .collect()
     };
     let mut touched = vec![false; mesh.n_points()];
     let mut removed = 0;
     let mut scratch = FaceScratch::default();
-    for (&t, plan) in candidates.iter().zip(found) {
+    for (&t, (plan, apexes)) in candidates.iter().zip(found) {
         if !mesh.is_alive(t) || tr.tq[t as usize] >= opts.edge_threshold {
             continue;
         }
-        let stale = (0..4).any(|f| {
-            let h = mesh.adj(t)[f];
-            touched[mesh.tet(t)[f] as usize]
-                || (h != crate::mesh::NO_ADJ
-                    && touched[mesh.tet(h >> 2)[(h & 3) as usize] as usize])
-        });
+        // While no vertex of `t` is touched, neither is `t` nor a neighbour
+        // (a new tet next to `t` shares a face with it, whose vertices are
+        // in the new tet's cavity), so the apexes are the search's.
+        let stale = mesh.tet(t).iter().any(|&x| touched[x as usize])
+            || apexes.iter().any(|&x| x != NO_APEX && touched[x as usize]);
         let mut plan = if stale {
             first_face_plan(mesh, tr, t, 0, movable, opts, &mut scratch)
         } else {
