@@ -205,6 +205,30 @@ fn straight(a: DVec3, v: DVec3, b: DVec3) -> bool {
     da.dot(db) < 0.0 && da.cross(db).length() <= 1e-12 * da.length() * db.length()
 }
 
+/// Whether the faces of the star `fs` of `v` are connected through the
+/// edges at `v` they share. At a pinch, where pieces of the domain touch at
+/// `v` only, they are not, and neither is `v`'s ball: a walk from one of its
+/// tets ([`TetMesh::ball`]) sees one piece, so a move judged on that piece
+/// alone could invert a tet of another.
+fn star_is_connected(faces: &[[u32; 3]], fs: &[u32], v: u32) -> bool {
+    let Some(&first) = fs.first() else {
+        return true;
+    };
+    let mut reached = vec![first];
+    let mut i = 0;
+    while i < reached.len() {
+        let f = faces[reached[i] as usize];
+        i += 1;
+        for &g in fs {
+            if !reached.contains(&g) && faces[g as usize].iter().any(|&u| u != v && f.contains(&u))
+            {
+                reached.push(g);
+            }
+        }
+    }
+    reached.len() == fs.len()
+}
+
 /// Whether two faces of the star `fs` of `v` that share an edge have
 /// normals more than `angle` degrees apart. The faces' orientations are not
 /// consistent across an interface (each is taken from one of its sides), so
@@ -324,7 +348,11 @@ impl BoundarySmoother {
             let on_cut = fs
                 .iter()
                 .any(|&f| crate::mesh::partition::is_partition_marker(keys[f as usize].0));
-            kind[v as usize] = if mesh.is_corner(v) || mesh.is_required(v) || on_cut {
+            kind[v as usize] = if mesh.is_corner(v)
+                || mesh.is_required(v)
+                || on_cut
+                || !star_is_connected(&faces, fs, v)
+            {
                 Kind::Fixed
             } else if let Some(nb) = line_nbrs.get(&v) {
                 // Under the linear rule (flat stars only) a line vertex stays:
@@ -899,6 +927,55 @@ mod tests {
         assert!(ball_valid(&m, &ball));
         m.check().unwrap();
         assert!((vol(&m) - 27.0).abs() < 1e-12, "volume {}", vol(&m));
+    }
+
+    /// Two square pyramids, one below the plane z = 0 and one above it
+    /// (turned by 45°), each cut into four tets around its axis, share
+    /// only the vertex `v` at the origin, the centre of both bases. Each
+    /// piece's star at `v` is a flat disk, so without the connectivity test
+    /// `v` would count as a surface vertex, and a walk from one of its tets
+    /// sees four of its eight tets.
+    #[test]
+    fn a_pinch_vertex_stays() {
+        let r = std::f64::consts::SQRT_2;
+        let mut points = vec![[0.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 0.0, 1.0]];
+        points.extend([
+            [1.0, 1.0, 0.0],
+            [-1.0, 1.0, 0.0],
+            [-1.0, -1.0, 0.0],
+            [1.0, -1.0, 0.0],
+        ]);
+        points.extend([[r, 0.0, 0.0], [0.0, r, 0.0], [-r, 0.0, 0.0], [0.0, -r, 0.0]]);
+        let mut tets = Vec::new();
+        for i in 0..4u32 {
+            let (a, b) = (3 + i, 3 + (i + 1) % 4);
+            tets.push([0, b, a, 1]);
+            let (c, d) = (7 + i, 7 + (i + 1) % 4);
+            tets.push([0, c, d, 2]);
+        }
+        let data = crate::mesh::MeshData {
+            points,
+            tets,
+            ..Default::default()
+        };
+        let mut m = TetMesh::from_data(&data).expect("two pyramids").0;
+        assert!(m
+            .tet_ids()
+            .all(|t| crate::geom::tet_volume(&m.tet_points(t)) > 0.0));
+        let mut ball = Vec::new();
+        m.ball(0, &mut ball);
+        assert_eq!(ball.len(), 4, "the walk sees one pyramid");
+        crate::refine::features::detect_features(&mut m, 45.0);
+        let s = BoundarySmoother::new(&m, BoundarySmoothOptions::default());
+        assert_eq!(s.kind[0], Kind::Fixed);
+        // A base corner is on a crease of its own pyramid: fixed too.
+        assert!(!s.is_movable(3));
+        m.set_point(0, DVec3::new(0.3, 0.1, 0.0));
+        let s = BoundarySmoother::new(&m, BoundarySmoothOptions::default());
+        let mut report = BoundarySmoothReport::default();
+        s.pass(&mut m, &[0], &mut report);
+        assert_eq!(report.surface_moves, 0);
+        assert_eq!(m.point(0), DVec3::new(0.3, 0.1, 0.0));
     }
 
     #[test]
