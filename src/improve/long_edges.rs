@@ -27,6 +27,7 @@ use crate::geom::tet_min_sine;
 use crate::mesh::TetMesh;
 use crate::ops::edge_split::split_halves;
 use crate::ops::edge_split::split_shell;
+use crate::ops::TetsAtVertex;
 use rayon::prelude::*;
 
 /// Per vertex, the sorted distinct neighbours of `v` (through its ball).
@@ -137,12 +138,7 @@ pub(crate) fn split_long_edges(
     }
     let n = mesh.n_points() as u32;
     let fixed = mesh.fixed_vertices();
-    let mut tets_at = vec![0u32; n as usize];
-    for t in mesh.tet_ids() {
-        for v in mesh.tet(t) {
-            tets_at[v as usize] += 1;
-        }
-    }
+    let tets_at = TetsAtVertex::new(mesh);
     // One ball walk per vertex: its mean edge length, and its neighbours of
     // higher id with the edge's length (each edge once, at its lower end),
     // by blocks of vertices so that the lists stay in a few flat arrays.
@@ -190,6 +186,7 @@ pub(crate) fn split_long_edges(
         let mean_len = &mean_len;
         let zone = &zone;
         let fixed = &fixed;
+        let tets_at = &tets_at;
         blocks
             .par_iter()
             .enumerate()
@@ -211,7 +208,7 @@ pub(crate) fn split_long_edges(
                                     length: l,
                                     a,
                                     b,
-                                    whole_ball: walked == tets_at[a as usize] as usize,
+                                    whole_ball: walked == tets_at.at(a) as usize,
                                     kept: split_is_kept(mesh, a, b, bar, sh),
                                     shell: start..shells.len(),
                                 });
