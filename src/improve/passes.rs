@@ -605,6 +605,12 @@ fn contract_pass(
     let mut ball = Vec::new();
     let mut scratch = Vec::new();
     let mut contracted = 0;
+    // A boundary vertex where pieces of the domain touch (a pinch) has
+    // tets the walk around it does not reach: contracting the piece it
+    // sees would retire a point the others still hold. The tets at each
+    // vertex are counted to tell; an interior vertex is never a pinch.
+    let mut tets_at = boundary_zone.map(|_| TetsAtVertex::new(mesh));
+    let mut old = Vec::new();
     for t in candidates {
         if !mesh.is_alive(t) || tr.tq[t as usize] >= opts.threshold {
             continue;
@@ -625,13 +631,21 @@ fn contract_pass(
                     continue;
                 }
                 mesh.ball(v, &mut ball);
-                if !ball.iter().all(|&b| tr.is_allowed(b)) {
+                if !ball.iter().all(|&b| tr.is_allowed(b))
+                    || tets_at
+                        .as_ref()
+                        .is_some_and(|c| c.at(v) as usize != ball.len())
+                {
                     continue;
                 }
                 let beat = ball
                     .iter()
                     .map(|&b| tr.tq[b as usize])
                     .fold(f64::INFINITY, f64::min);
+                if tets_at.is_some() {
+                    old.clear();
+                    old.extend(ball.iter().map(|&b| mesh.tet(b)));
+                }
                 let done = match (boundary_zone, &opts.boundary) {
                     (Some(_), Some(b)) => {
                         let mean_edge = (0..6).map(len).map(f64::sqrt).sum::<f64>() / 6.0;
@@ -645,6 +659,9 @@ fn contract_pass(
                     _ => crate::ops::contract_edge(mesh, v, u, beat, &mut scratch),
                 };
                 if let Ok(new) = done {
+                    if let Some(c) = &mut tets_at {
+                        c.replaced(&old, &new, mesh);
+                    }
                     tr.replaced(mesh, &ball, &new);
                     movable[v as usize] = false;
                     contracted += 1;
@@ -1415,5 +1432,74 @@ fn decide_moves(
             .with_min_len(32)
             .map_init(SmoothScratch::default, |s, &i| one(s, i))
             .collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::MeshData;
+
+    /// Two square pyramids that touch only at vertex 0 (`v`): one below the
+    /// plane z = 0, its base `a0 … a3` (±1, ±1) fanned from `v`, which sits
+    /// near `a0`, so the two tets at the short edge `v`–`a0` are slivers;
+    /// one above it, its larger base (±3 on the axes) fanned from `v` too.
+    /// Each piece's boundary star at `v` is a flat disk, so contracting
+    /// `v` into `a0` is a valid boundary contraction for the lower piece
+    /// alone, and the walk around `v` sees only that piece.
+    fn pinched_pyramids() -> TetMesh {
+        let mut points = vec![[0.9, 0.9, 0.0], [0.0, 0.0, -2.0], [0.0, 0.0, 2.0]];
+        points.extend([
+            [1.0, 1.0, 0.0],
+            [-1.0, 1.0, 0.0],
+            [-1.0, -1.0, 0.0],
+            [1.0, -1.0, 0.0],
+        ]);
+        points.extend([
+            [3.0, 0.0, 0.0],
+            [0.0, 3.0, 0.0],
+            [-3.0, 0.0, 0.0],
+            [0.0, -3.0, 0.0],
+        ]);
+        let mut tets = Vec::new();
+        for i in 0..4u32 {
+            tets.push([0, 7 + i, 7 + (i + 1) % 4, 2]);
+            tets.push([0, 3 + (i + 1) % 4, 3 + i, 1]);
+        }
+        let data = MeshData {
+            points,
+            tets,
+            ..Default::default()
+        };
+        TetMesh::from_data(&data).expect("two pyramids").0
+    }
+
+    fn volume(m: &TetMesh) -> f64 {
+        m.tet_ids()
+            .map(|t| crate::geom::tet_volume(&m.tet_points(t)))
+            .sum()
+    }
+
+    #[test]
+    fn a_pinch_vertex_is_not_contracted() {
+        let mut m = pinched_pyramids();
+        // Base areas 4 and 18, heights 2: (4 · 2 + 18 · 2) / 3.
+        let exact = 44.0 / 3.0;
+        assert!((volume(&m) - exact).abs() < 1e-12);
+        assert!(m.tet_ids().all(|t| tet_min_sine(&m.tet_points(t)) > 0.0));
+        let mut ball = Vec::new();
+        m.ball(0, &mut ball);
+        assert_eq!(ball.len(), 4, "the walk sees one pyramid");
+        crate::refine::features::detect_features(&mut m, 45.0);
+        assert!(!m.is_corner(0));
+        let report = improve(&mut m, &ImproveOptions::default());
+        m.check().expect("a valid mesh");
+        assert!((volume(&m) - exact).abs() < 1e-12, "volume {}", volume(&m));
+        assert!(m.tet_ids().any(|t| m.tet(t).contains(&0)));
+        assert_eq!(report.edges_contracted, 0, "{report:?}");
+        assert!(m.tet_of_vertex(0).is_some_and(|t| m.tet(t).contains(&0)));
+        m.compact();
+        m.check().expect("a valid mesh after compaction");
+        assert!((volume(&m) - exact).abs() < 1e-12, "volume {}", volume(&m));
     }
 }

@@ -213,6 +213,19 @@ impl TetsAtVertex {
         self.0.get(v as usize).copied().unwrap_or(0)
     }
 
+    /// The tets `old` (their corners) were replaced by the tets `new` of
+    /// `mesh`.
+    pub(crate) fn replaced(&mut self, old: &[[u32; 4]], new: &[u32], mesh: &TetMesh) {
+        for v in old.iter().flatten() {
+            self.0[*v as usize] -= 1;
+        }
+        for &t in new {
+            for v in mesh.tet(t) {
+                self.0[v as usize] += 1;
+            }
+        }
+    }
+
     /// The ring's tets were replaced by the tets `new` of `mesh`.
     fn replace(&mut self, ring: &EdgeRing, new: &[u32], mesh: &TetMesh) {
         let m = ring.tets.len() as u32;
