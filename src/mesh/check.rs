@@ -27,6 +27,10 @@ pub enum CheckError {
     /// A boundary edge has an odd number of boundary faces.
     #[error("boundary edge {0:?} has {1} boundary faces (a closed boundary has an even number)")]
     NonManifoldBoundary([u32; 2], usize),
+    /// A vertex's entry in the vertex → tet table names a tet that does
+    /// not hold it, or none while a live tet holds it.
+    #[error("vertex {0}: its tet entry is stale")]
+    VertexTet(u32),
     /// A tag names a face, edge or vertex the mesh does not have.
     #[error("tag inconsistent: {0}")]
     Tag(String),
@@ -124,6 +128,28 @@ impl TetMesh {
         if let Some(e) = first_err {
             return Err(e);
         }
+        // The vertex → tet table: an entry names a live tet holding the
+        // vertex, and every vertex of a live tet has one.
+        if self.v2t.len() != self.points.len() {
+            return Err(CheckError::Lengths);
+        }
+        let mut used = vec![false; self.points.len()];
+        for t in self.tet_ids() {
+            for x in self.tets[t as usize] {
+                used[x as usize] = true;
+            }
+        }
+        let stale = (0..np).find(|&x| {
+            let t = self.v2t[x as usize];
+            if t == DEAD {
+                used[x as usize]
+            } else {
+                t as usize >= n || !self.tets[t as usize].contains(&x)
+            }
+        });
+        if let Some(x) = stale {
+            return Err(CheckError::VertexTet(x));
+        }
 
         // Boundary manifoldness and tag consistency need the face and edge sets.
         let mut boundary_edge_count: HashMap<[u32; 2], usize> = HashMap::new();
@@ -184,5 +210,32 @@ impl TetMesh {
             )));
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::generate::cube_grid;
+
+    #[test]
+    fn a_stale_vertex_tet_entry_is_caught() {
+        let (mut mesh, _) = TetMesh::from_data(&cube_grid(2)).unwrap();
+        mesh.check().unwrap();
+        // A vertex held by live tets with no entry (a point retired while
+        // a tet still holds it).
+        let v = mesh.tet(0)[0];
+        let saved = mesh.v2t[v as usize];
+        mesh.v2t[v as usize] = DEAD;
+        assert_eq!(mesh.check(), Err(CheckError::VertexTet(v)));
+        // An entry naming a tet that does not hold the vertex.
+        let other = mesh
+            .tet_ids()
+            .find(|&t| !mesh.tet(t).contains(&v))
+            .expect("a tet away from v");
+        mesh.v2t[v as usize] = other;
+        assert_eq!(mesh.check(), Err(CheckError::VertexTet(v)));
+        mesh.v2t[v as usize] = saved;
+        mesh.check().unwrap();
     }
 }
