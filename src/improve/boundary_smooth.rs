@@ -930,34 +930,14 @@ mod tests {
     }
 
     /// Two square pyramids, one below the plane z = 0 and one above it
-    /// (turned by 45°), each cut into four tets around its axis, share
-    /// only the vertex `v` at the origin, the centre of both bases. Each
+    /// (turned by 45°), share only the vertex `v` at the origin, the centre
+    /// of both bases ([`crate::mesh::generate::pinched_pyramids`]). Each
     /// piece's star at `v` is a flat disk, so without the connectivity test
     /// `v` would count as a surface vertex, and a walk from one of its tets
     /// sees four of its eight tets.
     #[test]
     fn a_pinch_vertex_stays() {
-        let r = std::f64::consts::SQRT_2;
-        let mut points = vec![[0.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 0.0, 1.0]];
-        points.extend([
-            [1.0, 1.0, 0.0],
-            [-1.0, 1.0, 0.0],
-            [-1.0, -1.0, 0.0],
-            [1.0, -1.0, 0.0],
-        ]);
-        points.extend([[r, 0.0, 0.0], [0.0, r, 0.0], [-r, 0.0, 0.0], [0.0, -r, 0.0]]);
-        let mut tets = Vec::new();
-        for i in 0..4u32 {
-            let (a, b) = (3 + i, 3 + (i + 1) % 4);
-            tets.push([0, b, a, 1]);
-            let (c, d) = (7 + i, 7 + (i + 1) % 4);
-            tets.push([0, c, d, 2]);
-        }
-        let data = crate::mesh::MeshData {
-            points,
-            tets,
-            ..Default::default()
-        };
+        let data = crate::mesh::generate::pinched_pyramids([0.0; 3], std::f64::consts::SQRT_2, 1.0);
         let mut m = TetMesh::from_data(&data).expect("two pyramids").0;
         assert!(m
             .tet_ids()

@@ -1438,41 +1438,7 @@ fn decide_moves(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::mesh::MeshData;
-
-    /// Two square pyramids that touch only at vertex 0 (`v`): one below the
-    /// plane z = 0, its base `a0 … a3` (±1, ±1) fanned from `v`, which sits
-    /// near `a0`, so the two tets at the short edge `v`–`a0` are slivers;
-    /// one above it, its larger base (±3 on the axes) fanned from `v` too.
-    /// Each piece's boundary star at `v` is a flat disk, so contracting
-    /// `v` into `a0` is a valid boundary contraction for the lower piece
-    /// alone, and the walk around `v` sees only that piece.
-    fn pinched_pyramids() -> TetMesh {
-        let mut points = vec![[0.9, 0.9, 0.0], [0.0, 0.0, -2.0], [0.0, 0.0, 2.0]];
-        points.extend([
-            [1.0, 1.0, 0.0],
-            [-1.0, 1.0, 0.0],
-            [-1.0, -1.0, 0.0],
-            [1.0, -1.0, 0.0],
-        ]);
-        points.extend([
-            [3.0, 0.0, 0.0],
-            [0.0, 3.0, 0.0],
-            [-3.0, 0.0, 0.0],
-            [0.0, -3.0, 0.0],
-        ]);
-        let mut tets = Vec::new();
-        for i in 0..4u32 {
-            tets.push([0, 7 + i, 7 + (i + 1) % 4, 2]);
-            tets.push([0, 3 + (i + 1) % 4, 3 + i, 1]);
-        }
-        let data = MeshData {
-            points,
-            tets,
-            ..Default::default()
-        };
-        TetMesh::from_data(&data).expect("two pyramids").0
-    }
+    use crate::mesh::generate::pinched_pyramids;
 
     fn volume(m: &TetMesh) -> f64 {
         m.tet_ids()
@@ -1482,7 +1448,14 @@ mod tests {
 
     #[test]
     fn a_pinch_vertex_is_not_contracted() {
-        let mut m = pinched_pyramids();
+        // Two pyramids touching at `v` = (0.9, 0.9, 0) only
+        // ([`pinched_pyramids`]): `v` sits near the lower base's corner
+        // `a0` (point 3), so the two tets at the short edge `v`–`a0` are
+        // slivers. Each piece's boundary star at `v` is a flat disk, so
+        // contracting `v` into `a0` is a valid boundary contraction for the
+        // lower piece alone, which is all the walk around `v` sees.
+        let data = pinched_pyramids([0.9, 0.9, 0.0], 3.0, 2.0);
+        let mut m = TetMesh::from_data(&data).expect("two pyramids").0;
         // Base areas 4 and 18, heights 2: (4 · 2 + 18 · 2) / 3.
         let exact = 44.0 / 3.0;
         assert!((volume(&m) - exact).abs() < 1e-12);

@@ -70,6 +70,41 @@ pub fn cube_grid(n: usize) -> MeshData {
     }
 }
 
+/// Two square pyramids that touch only at point 0, `v` (a pinch: the walk
+/// around `v` from one of its tets sees one pyramid): one below the plane
+/// z = 0 (apex point 1 at depth `depth`), its base points 3–6 at (±1, ±1),
+/// and one above it (apex point 2 at height `depth`), its base points 7–10
+/// at ±`half` on the axes; each base is fanned from `v`, which must lie
+/// inside both, into four tets, listed upper and lower in turn (in this
+/// order `v`'s stored tet is in the lower pyramid). Tests of operations at
+/// pinch vertices use it.
+#[cfg(test)]
+pub(crate) fn pinched_pyramids(v: [f64; 3], half: f64, depth: f64) -> MeshData {
+    let mut points = vec![v, [0.0, 0.0, -depth], [0.0, 0.0, depth]];
+    points.extend([
+        [1.0, 1.0, 0.0],
+        [-1.0, 1.0, 0.0],
+        [-1.0, -1.0, 0.0],
+        [1.0, -1.0, 0.0],
+    ]);
+    points.extend([
+        [half, 0.0, 0.0],
+        [0.0, half, 0.0],
+        [-half, 0.0, 0.0],
+        [0.0, -half, 0.0],
+    ]);
+    let mut tets = Vec::new();
+    for i in 0..4u32 {
+        tets.push([0, 7 + i, 7 + (i + 1) % 4, 2]);
+        tets.push([0, 3 + (i + 1) % 4, 3 + i, 1]);
+    }
+    MeshData {
+        points,
+        tets,
+        ..MeshData::default()
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
