@@ -46,17 +46,6 @@ fn neighbours(mesh: &TetMesh, v: u32, ball: &mut Vec<u32>, out: &mut Vec<u32>) {
 /// id with the edge's length.
 type NeighbourBlock = (Vec<f64>, Vec<u32>, Vec<(u32, f64)>);
 
-/// The tets holding edge `(a, b)`, from the ball of `a`, ascending; returns
-/// the number of tets of the ball walked (all of `a`'s unless `a` is a
-/// pinch: tets at `a` that are not face-connected around it).
-fn shell(mesh: &TetMesh, a: u32, b: u32, out: &mut Vec<u32>) -> usize {
-    mesh.ball(a, out);
-    let walked = out.len();
-    out.retain(|&t| mesh.tet(t).contains(&b));
-    out.sort_unstable();
-    walked
-}
-
 /// Whether no face of the shell holding `(a, b)` is constrained
 /// ([`TetMesh::face_is_constrained`]) and the edge is not a feature.
 fn is_free_edge(mesh: &TetMesh, a: u32, b: u32, sh: &[u32]) -> bool {
@@ -199,7 +188,7 @@ pub(crate) fn split_long_edges(
                     for &(b, l) in &upper[from..end as usize] {
                         let local = 0.5 * (mean_len[a as usize] + mean_len[b as usize]);
                         if l > factor * local && !(fixed[a as usize] && fixed[b as usize]) {
-                            let walked = shell(mesh, a, b, sh);
+                            let walked = mesh.edge_shell(a, b, sh);
                             if sh.iter().all(|&t| in_zone(zone, t)) && is_free_edge(mesh, a, b, sh)
                             {
                                 let start = shells.len();
@@ -265,7 +254,7 @@ pub(crate) fn split_long_edges(
             sh.clear();
             sh.extend(found.iter().map(|&(t, _)| t));
         } else {
-            shell(mesh, a, b, &mut sh);
+            mesh.edge_shell(a, b, &mut sh);
             if sh.is_empty()
                 || !sh.iter().all(|&t| in_zone(&zone, t))
                 || !split_is_kept(mesh, a, b, bar, &sh)
@@ -291,6 +280,7 @@ pub(crate) fn split_long_edges(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::mesh::generate::total_volume as volume;
     use crate::mesh::MeshData;
 
     /// A bipyramid with caps: the axis `a = (0,0,-3)`, `b = (0,0,3)`
@@ -322,12 +312,6 @@ mod tests {
         TetMesh::from_data(&data)
             .expect("a valid capped bipyramid")
             .0
-    }
-
-    fn volume(m: &TetMesh) -> f64 {
-        m.tet_ids()
-            .map(|t| crate::geom::tet_volume(&m.tet_points(t)))
-            .sum()
     }
 
     #[test]

@@ -1439,12 +1439,7 @@ fn decide_moves(
 mod tests {
     use super::*;
     use crate::mesh::generate::pinched_pyramids;
-
-    fn volume(m: &TetMesh) -> f64 {
-        m.tet_ids()
-            .map(|t| crate::geom::tet_volume(&m.tet_points(t)))
-            .sum()
-    }
+    use crate::mesh::generate::total_volume as volume;
 
     #[test]
     fn a_pinch_vertex_is_not_contracted() {

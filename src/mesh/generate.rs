@@ -1,4 +1,4 @@
-//! Generated meshes for tests and benchmarks.
+//! Generated meshes for tests and benchmarks, and the tests' total volume.
 //!
 //! [`cube_grid`] triangulates the unit cube with the Freudenthal–Kuhn scheme
 //! (H. Freudenthal, "Simplizialzerlegungen von beschränkter Flachheit", Annals
@@ -68,6 +68,15 @@ pub fn cube_grid(n: usize) -> MeshData {
         tets,
         ..MeshData::default()
     }
+}
+
+/// The sum of the signed volumes of `mesh`'s live tets, for tests that
+/// compare it with a closed form.
+#[cfg(test)]
+pub(crate) fn total_volume(mesh: &super::TetMesh) -> f64 {
+    mesh.tet_ids()
+        .map(|t| crate::geom::tet_volume(&mesh.tet_points(t)))
+        .sum()
 }
 
 /// Two square pyramids that touch only at point 0, `v` (a pinch: the walk

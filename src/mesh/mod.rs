@@ -751,6 +751,19 @@ impl TetMesh {
         (verts, tets)
     }
 
+    /// The tets holding edge `(a, b)` (its shell), ascending, into `out`
+    /// (cleared first), found through the ball of `a` ([`Self::ball`]); empty
+    /// when the walk from `a`'s stored tet does not reach the edge. Returns
+    /// the number of tets the walk saw: fewer than the tets at `a` only at a
+    /// pinch, where pieces of the domain touch at `a`.
+    pub(crate) fn edge_shell(&self, a: u32, b: u32, out: &mut Vec<u32>) -> usize {
+        self.ball(a, out);
+        let walked = out.len();
+        out.retain(|&t| self.tets[t as usize].contains(&b));
+        out.sort_unstable();
+        walked
+    }
+
     /// The tets around vertex `v` (its ball), found by walking face adjacency
     /// from one incident tet; appended to `out` (cleared first).
     pub fn ball(&self, v: u32, out: &mut Vec<u32>) {

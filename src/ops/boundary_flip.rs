@@ -226,34 +226,23 @@ impl TetsAtVertex {
         }
     }
 
-    /// The ring's tets were replaced by the tets `new` of `mesh`.
+    /// The ring's tets were replaced by the tets `new` of `mesh`: the old
+    /// tets were (a, b, p_i, p_i+1) along the open ring.
     fn replace(&mut self, ring: &EdgeRing, new: &[u32], mesh: &TetMesh) {
-        let m = ring.tets.len() as u32;
-        // Each old tet (a, b, p_i, p_i+1) held a and b; p_0 and p_m one
-        // each, the inner ring vertices two each.
-        for v in [ring.a, ring.b] {
-            self.0[v as usize] -= m;
-        }
-        for (i, &v) in ring.verts.iter().enumerate() {
-            let k = if i == 0 || i == ring.verts.len() - 1 {
-                1
-            } else {
-                2
-            };
-            self.0[v as usize] -= k;
-        }
-        for &t in new {
-            for v in mesh.tet(t) {
-                self.0[v as usize] += 1;
-            }
-        }
+        debug_assert_eq!(ring.verts.len(), ring.tets.len() + 1, "an open ring");
+        let old: Vec<[u32; 4]> = ring
+            .verts
+            .windows(2)
+            .map(|p| [ring.a, ring.b, p[0], p[1]])
+            .collect();
+        self.replaced(&old, new, mesh);
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::geom::tet_volume;
+    use crate::mesh::generate::total_volume as volume;
     use crate::mesh::{MeshData, NO_ADJ};
     use crate::topo::TET_EDGES;
 
@@ -328,10 +317,6 @@ mod tests {
     ) -> Result<Vec<u32>, OpError> {
         let mut counts = TetsAtVertex::new(m);
         flip_boundary_edge(m, t, e, limits, beat, &mut counts)
-    }
-
-    fn volume(m: &TetMesh) -> f64 {
-        m.tet_ids().map(|t| tet_volume(&m.tet_points(t))).sum()
     }
 
     fn boundary_faces(m: &TetMesh) -> usize {

@@ -55,9 +55,7 @@ pub fn split_edge(
     p: DVec3,
 ) -> Result<(u32, Vec<u32>), OpError> {
     let mut around = Vec::new();
-    mesh.ball(a, &mut around);
-    around.retain(|&t| mesh.tet(t).contains(&b));
-    around.sort_unstable();
+    mesh.edge_shell(a, b, &mut around);
     split_shell(mesh, a, b, p, &around)
 }
 
@@ -135,16 +133,11 @@ pub(crate) fn split_shell(
 mod tests {
     use super::*;
     use crate::mesh::generate::cube_grid;
+    use crate::mesh::generate::total_volume as volume;
     use crate::topo::TET_EDGES;
 
     fn cube(n: usize) -> TetMesh {
         TetMesh::from_data(&cube_grid(n)).expect("a cube").0
-    }
-
-    fn volume(m: &TetMesh) -> f64 {
-        m.tet_ids()
-            .map(|t| crate::geom::tet_volume(&m.tet_points(t)))
-            .sum()
     }
 
     #[test]

@@ -423,7 +423,7 @@ fn behind(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::geom::tet_volume;
+    use crate::mesh::generate::total_volume as volume;
     use crate::mesh::MeshData;
 
     /// A bipyramid: the polygon `ring` (counterclockwise seen from +z, in
@@ -449,12 +449,6 @@ mod tests {
         let (mesh, _) = TetMesh::from_data(&data).expect("valid bipyramid");
         mesh.check().expect("valid");
         (mesh, u, w)
-    }
-
-    fn volume(mesh: &TetMesh) -> f64 {
-        mesh.tet_ids()
-            .map(|t| tet_volume(&mesh.tet_points(t)))
-            .sum()
     }
 
     fn worst(mesh: &TetMesh) -> f64 {

@@ -380,8 +380,7 @@ pub(crate) fn split_quality(
     b: u32,
     shell: &mut Vec<u32>,
 ) -> Option<f64> {
-    mesh.ball(a, shell);
-    shell.retain(|&t| mesh.tet(t).contains(&b));
+    mesh.edge_shell(a, b, shell);
     if shell.is_empty() {
         return None;
     }
