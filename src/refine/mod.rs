@@ -250,6 +250,10 @@ pub struct StepReport {
     pub skipped_moves: usize,
     /// The optimize phase.
     pub improve: ImproveReport,
+    /// Input tets left unsplit (out of the selection) so that the step keeps
+    /// its input's worst dihedral angle: where the phases left a tet below
+    /// it, the step ran again without the input tets around it.
+    pub held: usize,
     /// Wall time of the whole step.
     pub seconds: f64,
     /// With `check_each_phase`: `phase: error` for every phase after which

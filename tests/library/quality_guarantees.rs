@@ -596,24 +596,16 @@ fn vertex_insertions_keep_the_regions_and_the_worst() {
 /// user or a cluster job would, so its features come from the file and the
 /// default detection), as a first step (feature edges kept) and as the
 /// second global step (`step_offset` 1: feature edges trisected): the
-/// step's worst minimum dihedral angle is at least its input's, which is
-/// already above the optimizer's 17.46° bar — the optimize phase takes the
-/// input's worst as its floor (`ImproveOptions::floor`) and ends with a
-/// local rescue round where a tet is still below it. Where the floor is not
-/// reached yet, the worst as measured (2026-12-05, bar 0.35, the ODT
-/// target in the smoother) stands in, so that the test catches a change
-/// either way: getfem_ladder (input 15.57°, at corners whose tets no
-/// operation lifts: a new point crowded against a corner's faces; 8.66° and
-/// 13.20° before the ODT target) and the holed bar as a first step (input
-/// 20.59°, one tet at a corner where a hole meets a face; 20.48° against
-/// 20.50° before the ODT target, which raised the first step's worst).
+/// step's worst minimum dihedral angle is at least its input's. The
+/// optimize phase takes the input's worst as its floor and ends with a
+/// local rescue round; where a tet is still below it (the holed bar as a
+/// first step, the ladder both ways: a new point crowded against a
+/// corner's faces, 19.82°, 12.42° and 15.10° against 20.59° and 15.57°
+/// before), the step runs again holding the input tets at the fault
+/// unsplit. Measured (2026-12-06): 2, 11 and 2 input tets held, out of
+/// 13,736 and 18,787; a step holds at most 1 %.
 #[test]
 fn a_refined_mesh_refined_again_keeps_its_worst() {
-    const GAPS: [(&str, usize, f64); 3] = [
-        ("getfem_holed_bar", 0, 19.82),
-        ("getfem_ladder", 0, 12.42),
-        ("getfem_ladder", 1, 15.10),
-    ];
     let dir = tempfile::tempdir().expect("temp dir");
     for name in SMALL {
         let mut m = load(name, Some(45.0));
@@ -624,32 +616,28 @@ fn a_refined_mesh_refined_again_keeps_its_worst() {
             let (mut m, _) = load_mesh(&path).expect("read back");
             detect_features(&mut m, 45.0);
             let input = checked_worst(&m, name);
+            let before = m.n_tets();
             let opts = RefineOptions {
                 step_offset: offset,
                 ..Default::default()
             };
-            refine_step(&mut m, 1, &opts);
+            let report = refine_step(&mut m, 1, &opts);
             let what = format!("{name} refined again, step offset {offset}");
             let worst = checked_worst(&m, &what);
-            eprintln!("{what}: worst {worst:.2}° (input {input:.2}°)");
-            match GAPS.iter().find(|g| g.0 == name && g.1 == offset) {
-                Some(&(_, _, measured)) => {
-                    assert!(
-                        worst >= measured - 0.005,
-                        "{what}: worst {worst:.2}° below the {measured:.2}° measured ({})",
-                        worst_tet_info(&m)
-                    );
-                    assert!(
-                        worst < input,
-                        "{what}: worst {worst:.2}° reaches the input's {input:.2}°: take it off the gaps"
-                    );
-                }
-                None => assert!(
-                    worst >= input,
-                    "{what}: worst {worst:.2}° below the input's {input:.2}° ({})",
-                    worst_tet_info(&m)
-                ),
-            }
+            eprintln!(
+                "{what}: worst {worst:.2}° (input {input:.2}°), {} input tets held",
+                report.held
+            );
+            assert!(
+                worst >= input,
+                "{what}: worst {worst:.2}° below the input's {input:.2}° ({})",
+                worst_tet_info(&m)
+            );
+            assert!(
+                report.held * 100 <= before,
+                "{what}: {} of {before} input tets held unsplit",
+                report.held
+            );
         }
     }
 }

@@ -410,6 +410,12 @@ pub fn run(a: Args) -> super::CliResult {
                     report.refused_flips, report.refused_boundary_flips, report.skipped_moves
                 );
             }
+            if report.held > 0 {
+                eprintln!(
+                    "note: step {s}: {} input tets left unsplit, where splitting them left a tet below the input's worst dihedral angle",
+                    report.held
+                );
+            }
         });
                 steps.push(StepStats::step(stats, &report));
             },
