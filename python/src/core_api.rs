@@ -441,6 +441,11 @@ impl Progress for HookProgress<'_> {
         let step = self.step.load(Relaxed);
         (self.hook)(step, phase.name(), total);
     }
+
+    fn step_again(&self, _phases: u64) {
+        // The retry begins with the split phase again: same step.
+        self.step.fetch_sub(1, std::sync::atomic::Ordering::Relaxed);
+    }
 }
 
 /// The union of the marking specs, or `None` for uniform refinement (the

@@ -651,7 +651,9 @@ impl Mesh {
     ///                 [--step-offset].
     ///   progress      True: one line per phase on sys.stderr; or a callable
     ///                 progress(step, phase, tets) called at the start of
-    ///                 every phase (an exception it raises stops the run).
+    ///                 every phase (an exception it raises stops the run); a
+    ///                 step that runs again to keep its input's worst (its
+    ///                 report's "held") repeats its phases, same step.
     ///   stats         Also compute quality() after every step, into the
     ///                 step's report as "quality" [--stats].
     ///   allow_empty   A selection that selects no tet returns the mesh

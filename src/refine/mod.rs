@@ -38,6 +38,9 @@ pub trait Progress: Sync {
     fn advance(&self, _n: u64) {}
     /// The phase is over.
     fn phase_end(&self) {}
+    /// The step runs again (holding tets back, see [`StepReport::held`]):
+    /// the ends of its last `phases` phases are taken back.
+    fn step_again(&self, _phases: u64) {}
 }
 
 /// Reports nothing.

@@ -147,8 +147,10 @@ fn step_keeping(
     let optimizes = opts.opt_passes > 0 && matches!(opts.stop_after, None | Some(Phase::Optimize));
     let worst_in = if optimizes { worst_dihedral(mesh) } else { 0.0 };
     let floor = worst_in.sin().max(0.0);
+    // A later step whose input is already below `keep` is held to its
+    // input's worst: the tets below `keep` there are not of its making.
     let keep = if optimizes {
-        keep.unwrap_or(worst_in)
+        keep.map_or(worst_in, |k| k.min(worst_in))
     } else {
         0.0
     };
@@ -200,6 +202,7 @@ fn step_keeping(
                 selection: Some(selection),
                 ..opts.clone()
             };
+            progress.step_again(report.phases.len() as u64);
             let attempt = std::mem::replace(mesh, input.clone());
             best = Some((worst, attempt, report));
             report = step_phases(mesh, step, &retry, progress, floor);
@@ -244,9 +247,9 @@ fn tets_below(mesh: &TetMesh, angle: f64) -> Vec<u32> {
 }
 
 /// Marks in `held` (per tet slot of `input`, the step's input) the input
-/// tets that share a vertex with an input tet holding a vertex or the
-/// centroid of one of `bad` (tets of the step's output `mesh`), located
-/// by a visibility walk from the bad tet's `parent`.
+/// tets holding a vertex or the centroid of one of `bad` (tets of the
+/// step's output `mesh`), located by a visibility walk from the bad tet's
+/// `parent`, and with `ring` every input tet sharing a vertex with those.
 fn hold_around(input: &TetMesh, mesh: &TetMesh, bad: &[u32], ring: bool, held: &mut [bool]) {
     let Some(first) = input.tet_ids().next() else {
         return;

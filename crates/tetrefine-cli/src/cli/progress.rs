@@ -81,4 +81,11 @@ impl Progress for BarProgress {
             self.bar.set_position(*d as u64);
         }
     }
+
+    fn step_again(&self, phases: u64) {
+        if let Ok(mut d) = self.phases_done.lock() {
+            *d = d.saturating_sub(phases as usize);
+            self.bar.set_position(*d as u64);
+        }
+    }
 }
