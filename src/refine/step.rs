@@ -56,8 +56,8 @@ pub fn refine_with_guard<E>(
 ) -> Result<(), E> {
     let mut step_opts = opts.clone();
     // Every step keeps the worst of the mesh the run was given (see
-    // [`step_keeping`]).
-    let keep = worst_dihedral(mesh);
+    // [`step_keeping`]); the first finds it itself.
+    let keep = (steps > 1).then(|| worst_dihedral(mesh));
     for s in 1..=steps {
         if s > 1 && opts.selection.is_some() {
             step_opts.selection = Some(descendants_of_last_step(mesh, s - 1));
@@ -69,7 +69,7 @@ pub fn refine_with_guard<E>(
             None => mesh.n_tets(),
         };
         before_step(s, mesh, split as u64)?;
-        let report = step_keeping(mesh, s, &step_opts, progress, Some(keep));
+        let report = step_keeping(mesh, s, &step_opts, progress, keep.filter(|_| s > 1));
         on_step(s, mesh, report);
     }
     Ok(())
@@ -237,13 +237,15 @@ fn tets_below(mesh: &TetMesh, angle: f64) -> Vec<u32> {
     (0..mesh.n_tet_slots() as u32)
         .into_par_iter()
         .with_min_len(4096)
-        .filter(|&t| {
-            mesh.is_alive(t)
-                && crate::geom::dihedral_angles(&mesh.tet_points(t))
-                    .into_iter()
-                    .any(|a| a < angle)
-        })
+        .filter(|&t| mesh.is_alive(t) && min_dihedral(mesh, t) < angle)
         .collect()
+}
+
+/// The smallest dihedral angle (radians) of tet `t`.
+fn min_dihedral(mesh: &TetMesh, t: u32) -> f64 {
+    crate::geom::dihedral_angles(&mesh.tet_points(t))
+        .into_iter()
+        .fold(f64::INFINITY, f64::min)
 }
 
 /// Marks in `held` (per tet slot of `input`, the step's input) the input
@@ -533,11 +535,7 @@ fn worst_dihedral(mesh: &TetMesh) -> f64 {
         .into_par_iter()
         .with_min_len(4096)
         .filter(|&t| mesh.is_alive(t))
-        .map(|t| {
-            crate::geom::dihedral_angles(&mesh.tet_points(t))
-                .into_iter()
-                .fold(f64::INFINITY, f64::min)
-        })
+        .map(|t| min_dihedral(mesh, t))
         .reduce(|| f64::INFINITY, f64::min);
     if worst.is_finite() {
         worst
