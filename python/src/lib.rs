@@ -887,7 +887,7 @@ impl Mesh {
     /// `tetrefine improve`. Returns a new Mesh whose `reports` hold one dict
     /// (passes, edges_removed, laplacian_moves, optimized_moves,
     /// surface_moves, line_moves, caps_removed, long_edges_split,
-    /// boundary_flips, edges_contracted, faces_removed, vertices_inserted;
+    /// long_edge_boundary_faces, boundary_flips, edges_contracted, faces_removed, vertices_inserted;
     /// improve alone never splits long edges, but it inserts a vertex where
     /// a sliver needs one and contracts short edges, so the point count may
     /// change).

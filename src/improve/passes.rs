@@ -145,6 +145,9 @@ pub struct ImproveReport {
     pub caps_removed: usize,
     /// Long edges split at their midpoint ([`ImproveOptions::long_edge_factor`]).
     pub long_edges_split: usize,
+    /// Boundary faces those splits cut in two, each adding one boundary
+    /// face (two for a boundary edge between two boundary faces).
+    pub long_edge_boundary_faces: usize,
     /// Boundary edges flipped ([`crate::ops::flip_boundary_edge`]).
     pub boundary_flips: usize,
     /// Short edges contracted, an interior vertex merged into a neighbour
@@ -168,6 +171,7 @@ impl ImproveReport {
         self.line_moves += other.line_moves;
         self.caps_removed += other.caps_removed;
         self.long_edges_split += other.long_edges_split;
+        self.long_edge_boundary_faces += other.long_edge_boundary_faces;
         self.boundary_flips += other.boundary_flips;
         self.edges_contracted += other.edges_contracted;
         self.faces_removed += other.faces_removed;
@@ -341,8 +345,10 @@ pub fn improve(mesh: &mut TetMesh, opts: &ImproveOptions) -> ImproveReport {
     let first_new_point = mesh.n_points();
     if let Some(factor) = opts.long_edge_factor {
         let mut zone = opts.long_edge_zone.clone().or_else(|| tet_allowed.clone());
-        let (splits, new_tets) = split_long_edges(mesh, factor, opts.threshold, zone.as_mut());
-        report.long_edges_split = splits;
+        let split = split_long_edges(mesh, factor, opts.threshold, zone.as_mut());
+        report.long_edges_split = split.edges;
+        report.long_edge_boundary_faces = split.boundary_faces;
+        let new_tets = split.new_tets;
         if let Some(a) = &mut tet_allowed {
             a.resize(mesh.n_tet_slots().max(a.len()), false);
             for t in new_tets {

@@ -67,17 +67,19 @@ fn tripod_full_step_quality() {
             "{rule:?} {r:?}\n{} tets worst {:.2} avg {:.2}",
             s.tets, s.min_dihedral_deg.worst, s.min_dihedral_deg.avg
         );
-        // The √3 phases give 5,476 points; each long-edge split of the
-        // optimize phase adds its midpoint and, splitting interior edges
-        // only, no boundary face; each vertex insertion (on an interior
-        // edge) adds one interior point; each edge contraction takes out
-        // one interior point and no boundary face.
+        // The √3 phases give 5,476 points and 5,130 boundary faces; each
+        // long-edge split of the optimize phase adds its midpoint and one
+        // boundary face per boundary face it cuts in two (two for an edge
+        // of the tripod's manifold boundary); each vertex insertion (on an
+        // interior edge) adds one interior point; each edge contraction
+        // takes out one interior point and no boundary face.
         assert_eq!(
             s.nodes,
             5_476 + r.improve.long_edges_split + r.improve.vertices_inserted
                 - r.improve.edges_contracted
         );
-        assert_eq!(s.boundary_faces, 5_130);
+        assert_eq!(s.boundary_faces, 5_130 + r.improve.long_edge_boundary_faces);
+        assert_eq!(r.improve.long_edge_boundary_faces % 2, 0);
         assert_eq!(s.inverted, 0);
     }
 }
@@ -85,10 +87,12 @@ fn tripod_full_step_quality() {
 #[test]
 fn tripod_second_step_adds_one_point_per_tet_and_boundary_face() {
     // After step 1 the mesh has 5,476 vertices (plus one per long edge
-    // split or vertex insertion, minus one per edge contraction), T1 tets and 5,130 boundary
-    // faces; step 2 adds one barycentre per tet and one point per boundary
-    // face (plus its long-edge splits and insertions, minus its
-    // contractions).
+    // split or vertex insertion, minus one per edge contraction), T1 tets
+    // and 5,130 boundary faces (plus one per boundary face a long-edge
+    // split cut in two); step 2 adds one barycentre per tet and one point
+    // per boundary face (plus its long-edge splits and insertions, minus
+    // its contractions), and makes three boundary faces of each (plus its
+    // long-edge splits' faces).
     let mut m = tripod();
     let opts = RefineOptions::default();
     let r1 = refine_step(&mut m, 1, &opts);
@@ -99,7 +103,7 @@ fn tripod_second_step_adds_one_point_per_tet_and_boundary_face() {
         (
             5_476 + r1.improve.long_edges_split + r1.improve.vertices_inserted
                 - r1.improve.edges_contracted,
-            5_130
+            5_130 + r1.improve.long_edge_boundary_faces
         )
     );
     let r2 = refine_step(&mut m, 2, &opts);
@@ -107,8 +111,15 @@ fn tripod_second_step_adds_one_point_per_tet_and_boundary_face() {
     let s2 = MeshStats::compute(&m);
     assert_eq!(
         s2.nodes,
-        s1.nodes + s1.tets + 5_130 + r2.improve.long_edges_split + r2.improve.vertices_inserted
+        s1.nodes
+            + s1.tets
+            + s1.boundary_faces
+            + r2.improve.long_edges_split
+            + r2.improve.vertices_inserted
             - r2.improve.edges_contracted
     );
-    assert_eq!(s2.boundary_faces, 3 * 5_130);
+    assert_eq!(
+        s2.boundary_faces,
+        3 * s1.boundary_faces + r2.improve.long_edge_boundary_faces
+    );
 }

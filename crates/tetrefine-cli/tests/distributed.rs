@@ -378,7 +378,7 @@ fn a_gathered_output_keeps_feature_edges_corners_and_regions() {
     for name in ["meshes/tripod.mesh", "meshes/gmsh_t16.mesh"] {
         let serial = dir.path().join("s.mesh");
         let (s_lines, g_lines) = (dir.path().join("s.csv"), dir.path().join("g.csv"));
-        serial_ok(&[
+        let o = serial_ok(&[
             "refine",
             name,
             "-o",
@@ -386,6 +386,14 @@ fn a_gathered_output_keeps_feature_edges_corners_and_regions() {
             "--features-out",
             s_lines.to_str().unwrap(),
         ]);
+        // The input's feature edges as detected ("features: N edges").
+        let err = String::from_utf8_lossy(&o.stderr);
+        let detected: usize = err
+            .split("features: ")
+            .nth(1)
+            .and_then(|r| r.split(' ').next())
+            .and_then(|n| n.parse().ok())
+            .unwrap_or_else(|| panic!("{name}: no feature count in {err}"));
         let out = dir.path().join("g.mesh");
         mpirun_ok(
             2,
@@ -398,17 +406,22 @@ fn a_gathered_output_keeps_feature_edges_corners_and_regions() {
                 g_lines.to_str().unwrap(),
             ],
         );
-        // `--features-out` writes the union's lines: as many rows as the
-        // serial run's (the same edges; vertices may slide along lines).
-        let rows = |p: &Path| std::fs::read_to_string(p).unwrap().lines().count();
-        assert_eq!(rows(&g_lines), rows(&s_lines), "{name}");
         let (s, _) = tetrefine::io::load_mesh(&serial).unwrap();
         let (g, _) = tetrefine::io::load_mesh(&out).unwrap();
         g.check().unwrap();
+        // `--features-out` writes the union's lines: after the header, a
+        // two-point polyline (two rows) per feature edge of the gathered
+        // mesh, as the serial run's file has per edge of its mesh.
+        let rows = |p: &Path| std::fs::read_to_string(p).unwrap().lines().count();
+        assert_eq!(rows(&g_lines), 1 + 2 * g.feature_edges().len(), "{name}");
+        assert_eq!(rows(&s_lines), 1 + 2 * s.feature_edges().len(), "{name}");
         // Step 1 keeps every feature edge whole (its vertices may slide
-        // along straight lines) and every corner in place: the same
-        // corners, by coordinates, the same number of feature edges and
-        // the same total feature length as the serial run.
+        // along straight lines) and every corner in place, but for the
+        // long feature edges the long-edge round splits at their
+        // midpoints, which depend on the cut (an edge on it stays whole,
+        // the mean lengths near it differ): the same corners, by
+        // coordinates, at least the detected feature edges, and the same
+        // total feature length as the serial run.
         let corners = |m: &TetMesh| {
             let mut c: Vec<[u64; 3]> = m
                 .corners()
@@ -426,7 +439,9 @@ fn a_gathered_output_keeps_feature_edges_corners_and_regions() {
         };
         assert!(!corners(&s).is_empty() && !s.feature_edges().is_empty());
         assert_eq!(corners(&g), corners(&s), "{name}");
-        assert_eq!(g.feature_edges().len(), s.feature_edges().len(), "{name}");
+        for m in [&g, &s] {
+            assert!(m.feature_edges().len() >= detected, "{name}");
+        }
         assert!(
             close(length(&g), length(&s), 1e-9),
             "{name}: {} vs {}",
@@ -1331,8 +1346,9 @@ fn an_inverted_or_degenerate_tet_in_a_piece_ends_every_rank_naming_the_piece_and
 /// A `.pvtu` written on two ranks has had one step (its pieces' `level`):
 /// refined again without `--step-offset`, on two ranks (each reading its
 /// own piece) or serially (reading both), the global count goes on, so the
-/// feature edges are trisected (three times as many, the even-step rule),
-/// and the note says so once.
+/// feature edges are trisected (three times as many, the even-step rule,
+/// and more where the long-edge round then splits a long one), and the
+/// note says so once.
 #[test]
 fn a_pvtu_refined_again_continues_its_step_count() {
     let dir = tempfile::tempdir().unwrap();
@@ -1369,7 +1385,12 @@ fn a_pvtu_refined_again_continues_its_step_count() {
         let text = std::fs::read_to_string(dir.path().join(json)).unwrap();
         let st: serde_json::Value = serde_json::from_str(&text).unwrap();
         let features = |k: usize| st["steps"][k]["feature_edges"].as_u64().unwrap();
-        assert_eq!(features(1), 3 * features(0), "{what}: trisected");
+        assert!(
+            features(1) >= 3 * features(0),
+            "{what}: trisected, {} from {}",
+            features(1),
+            features(0)
+        );
     }
 }
 

@@ -67,6 +67,11 @@ fn vtu_carries_level_and_parent_and_feature_lines_are_written() {
         "2",
         "--boundary",
         "linear",
+        // The default effort's long-edge round also splits long feature
+        // edges (one more segment each); `fast` has none, so the count
+        // below is the √3 rule's alone.
+        "--effort",
+        "fast",
         "--features-out",
         lines.to_str().unwrap(),
     ]);
@@ -121,7 +126,10 @@ fn bad_options_fail_before_any_work() {
 /// continues the global step count, so its feature edges are trisected in
 /// the second step (three times as many, the √3 scheme's even-step rule)
 /// instead of kept, and the worst angle stays at least the input's;
-/// `--step-offset 0` starts the count over (the edges kept).
+/// `--step-offset 0` starts the count over (the edges kept). The default
+/// effort's long-edge round may split a few long feature edges after the
+/// √3 phases, each adding one segment: trisection gives at least three
+/// times the input's segments, keeping fewer than twice as many.
 #[test]
 fn refining_a_refined_vtu_continues_its_step_count() {
     let dir = tempfile::tempdir().unwrap();
@@ -158,12 +166,17 @@ fn refining_a_refined_vtu_continues_its_step_count() {
     let worst = |s: &serde_json::Value, k: usize| {
         s["steps"][k]["min_dihedral_deg"]["worst"].as_f64().unwrap()
     };
-    assert_eq!(
+    assert!(
+        features(&s2, 1) >= 3 * features(&s2, 0),
+        "continued: trisected, {} from {}",
         features(&s2, 1),
-        3 * features(&s2, 0),
-        "continued: trisected"
+        features(&s2, 0)
     );
-    assert_eq!(features(&s0, 1), features(&s0, 0), "started over: kept");
+    let (kept, input) = (features(&s0, 1), features(&s0, 0));
+    assert!(
+        kept >= input && kept < 2 * input,
+        "started over: kept, {kept} from {input}"
+    );
     assert!(
         worst(&s2, 1) >= worst(&s2, 0),
         "worst {} below the input's {}",
