@@ -122,8 +122,9 @@ fn shell_qualities(mesh: &TetMesh, a: u32, b: u32, p: glam::DVec3, sh: &[u32]) -
     (old, new)
 }
 
-/// Splits every edge not on a partition face (see the module doc) longer than `factor` times the mean edge length at its two ends, longest
-/// first, at its midpoint. An edge is split only when every tet of its shell
+/// Splits every edge not on a partition face (nor, between two fixed
+/// vertices, at a pinch; see the module doc) longer than `factor` times the
+/// mean edge length at its two ends, longest first, at its midpoint. An edge is split only when every tet of its shell
 /// is in `zone` (per tet slot; `None`: every tet; the new tets join it) and
 /// when the worst of the new tets is at least the smaller of the shell's
 /// worst and `bar` (min sine), so the pass never lowers the worst tet below
@@ -318,6 +319,7 @@ pub(crate) fn split_long_edges(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::mesh::generate::boundary_face_count;
     use crate::mesh::generate::total_volume as volume;
     use crate::mesh::MeshData;
 
@@ -396,26 +398,27 @@ mod tests {
         assert_eq!(split_long_edges(&mut m, 1.8, 0.3, None).edges, 1);
     }
 
+    /// The bipyramid's points with only its tets `ids` (slots of
+    /// [`bipyramid`]).
+    fn bipyramid_part(ids: std::ops::Range<u32>) -> TetMesh {
+        let m = bipyramid();
+        let data = MeshData {
+            points: m.points().iter().map(|p| p.to_array()).collect(),
+            tets: ids.map(|t| m.tet(t)).collect(),
+            ..Default::default()
+        };
+        TetMesh::from_data(&data)
+            .expect("a part of the bipyramid")
+            .0
+    }
+
     /// The capped bipyramid without the axis tet `(a, b, r0, r1)`: the axis
     /// now lies on the boundary, between the boundary faces `(a, b, r0)`
     /// and `(a, b, r1)`, with a shell of five tets. Every edge of the capped
     /// bipyramid is still there (the removed tet's other edges are held by
     /// its neighbours), so the means and the factor of [`bipyramid`] hold.
     fn notched() -> TetMesh {
-        let m = bipyramid();
-        let tets: Vec<[u32; 4]> = (1..18).map(|t| m.tet(t)).collect();
-        let data = MeshData {
-            points: m.points().iter().map(|p| p.to_array()).collect(),
-            tets,
-            ..Default::default()
-        };
-        TetMesh::from_data(&data).expect("the notched bipyramid").0
-    }
-
-    fn boundary_faces(m: &TetMesh) -> usize {
-        m.tet_ids()
-            .map(|t| (0..4).filter(|&f| m.is_boundary_face(t, f)).count())
-            .sum()
+        bipyramid_part(1..18)
     }
 
     #[test]
@@ -426,7 +429,7 @@ mod tests {
         let exact = 6.0 * 3f64.sqrt() / 4.0 * (8.0 - 6.0 / 6.0) / 3.0;
         assert!((volume(&m) - exact).abs() < 1e-12);
         // The caps' twelve outer faces and the removed tet's four.
-        assert_eq!(boundary_faces(&m), 12 + 4);
+        assert_eq!(boundary_face_count(&m), 12 + 4);
         for q in [2, 3] {
             m.set_face_marker([0, 1, q], Some(5));
         }
@@ -441,7 +444,7 @@ mod tests {
         // The domain is unchanged: the same volume, each boundary face on
         // the axis split in two.
         assert!((volume(&m) - exact).abs() < 1e-12);
-        assert_eq!(boundary_faces(&m), 16 + 2);
+        assert_eq!(boundary_face_count(&m), 16 + 2);
         assert_eq!(m.feature_edge(0, mid), Some(9));
         assert_eq!(m.feature_edge(mid, 1), Some(9));
         assert!(!m.is_feature_edge(0, 1));
@@ -464,14 +467,7 @@ mod tests {
     fn a_chord_between_boundary_points_is_split() {
         // Without its caps the axis joins two boundary points through the
         // inside.
-        let mut m = bipyramid();
-        let tets: Vec<[u32; 4]> = (0..6).map(|t| m.tet(t)).collect();
-        let data = MeshData {
-            points: m.points().iter().map(|p| p.to_array()).collect(),
-            tets,
-            ..Default::default()
-        };
-        m = TetMesh::from_data(&data).expect("the uncapped bipyramid").0;
+        let mut m = bipyramid_part(0..6);
         // Means 6/7 + 6/7 at a and b ((6 + 6·√10)/7 ≈ 3.568), so the axis
         // stands 6/3.568 ≈ 1.68 times over them.
         assert_eq!(split_long_edges(&mut m, 1.7, 0.3, None).edges, 0);

@@ -79,6 +79,16 @@ pub(crate) fn total_volume(mesh: &super::TetMesh) -> f64 {
         .sum()
 }
 
+/// The number of boundary faces of `mesh`'s live tets (faces with no
+/// neighbour), for tests that count them by hand.
+#[cfg(test)]
+pub(crate) fn boundary_face_count(mesh: &super::TetMesh) -> usize {
+    mesh.tet_ids()
+        .flat_map(|t| mesh.adj(t))
+        .filter(|&h| h == super::NO_ADJ)
+        .count()
+}
+
 /// Two square pyramids that touch only at point 0, `v` (a pinch: the walk
 /// around `v` from one of its tets sees one pyramid): one below the plane
 /// z = 0 (apex point 1 at depth `depth`), its base points 3–6 at (±1, ±1),

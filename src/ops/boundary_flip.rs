@@ -242,8 +242,9 @@ impl TetsAtVertex {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::mesh::generate::boundary_face_count;
     use crate::mesh::generate::total_volume as volume;
-    use crate::mesh::{MeshData, NO_ADJ};
+    use crate::mesh::MeshData;
     use crate::topo::TET_EDGES;
 
     const EXACT: BoundaryFlipLimits = BoundaryFlipLimits {
@@ -319,13 +320,6 @@ mod tests {
         flip_boundary_edge(m, t, e, limits, beat, &mut counts)
     }
 
-    fn boundary_faces(m: &TetMesh) -> usize {
-        m.tet_ids()
-            .flat_map(|t| m.adj(t))
-            .filter(|&h| h == NO_ADJ)
-            .count()
-    }
-
     fn has_edge(m: &TetMesh, u: u32, v: u32) -> bool {
         m.tet_ids()
             .any(|t| m.tet(t).contains(&u) && m.tet(t).contains(&v))
@@ -342,7 +336,7 @@ mod tests {
         // Rhombus of diagonals 4 and 2 (area 4), height 1: volume 4/3.
         assert!((volume(&m) - 4.0 / 3.0).abs() < 1e-14, "{}", volume(&m));
         // 8 faces of two tets, one shared: 6 on the boundary, as before.
-        assert_eq!(boundary_faces(&m), 6);
+        assert_eq!(boundary_face_count(&m), 6);
         assert!(!has_edge(&m, 0, 1) && has_edge(&m, 2, 3));
         assert_eq!(m.face_marker([0, 2, 3]), Some(5));
         assert_eq!(m.face_marker([1, 2, 3]), Some(5));
@@ -397,7 +391,7 @@ mod tests {
             .collect();
         assert!(has_edge(&m, other[0], other[1]));
         assert!((volume(&m) - 1.0).abs() < 1e-15);
-        assert_eq!(boundary_faces(&m), 12);
+        assert_eq!(boundary_face_count(&m), 12);
     }
 
     #[test]
