@@ -686,9 +686,10 @@ impl Mesh {
     ///   hsiz          One target edge length everywhere [--hsiz].
     ///   hmax          The largest target edge length: caps size or hsiz,
     ///                 or alone is the size map [--hmax].
-    ///   effort        'fast' (boundary fixed), 'default' (boundary vertices
-    ///                 move inside their patch and along feature lines,
-    ///                 sliver caps removed) or 'best' [--effort].
+    ///   effort        'fast' (boundary fixed, no long-edge splits),
+    ///                 'default' (boundary vertices move inside their patch
+    ///                 and along feature lines, sliver caps removed, two
+    ///                 rounds of long-edge splits) or 'best' [--effort].
     ///   hausd         Hausdorff bound of boundary moves (MMG's -hausd);
     ///                 None: 5 % of the local edge length (15 % of a
     ///                 sliver cap's mean edge for its removal) [--hausd].

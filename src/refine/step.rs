@@ -345,8 +345,8 @@ fn step_phases(
     report
 }
 
-/// Phase 6: edge removal and smoothing, then (at the efforts that have it)
-/// the long-edge round and its settling passes, over the zone
+/// Phase 6: edge removal and smoothing, then (at the efforts that have them)
+/// the long-edge rounds, each with its settling passes, over the zone
 /// `--smooth` allows. Also run, without the long-edge round
 /// (`long_edges`) and over the band the cut froze (`zone`: per point, may
 /// it move; per tet slot, may its edges go), by the distributed driver once
@@ -394,11 +394,12 @@ pub(crate) fn optimize_phase(
     // Long edges are split once the passes have evened out the
     // step's new points (split on the raw √3 mesh they gain
     // half as much: tripod 41.6° against 43.4° average), then
-    // a second round of passes, with edge removal up to a
-    // higher bar, settles the new balls.
+    // passes with edge removal up to a higher bar settle the new
+    // balls; the effort sets how many such rounds run.
     let mut report = improve(mesh, &io);
-    if let Some(factor) = opts.effort.long_edge_factor().filter(|_| long_edges) {
-        // The first passes created and removed tets: the
+    let factor = opts.effort.long_edge_factor().filter(|_| long_edges);
+    for factor in std::iter::repeat_n(factor, opts.effort.long_edge_rounds()).flatten() {
+        // The passes before created and removed tets: the
         // zone is gathered again.
         let (movable, tet_allowed) = smoothing_zone(mesh, step, opts);
         let io = ImproveOptions {
@@ -416,8 +417,8 @@ pub(crate) fn optimize_phase(
             boundary: None,
             ..io
         };
-        let second = improve(mesh, &io);
-        report.add(&second);
+        let settled = improve(mesh, &io);
+        report.add(&settled);
     }
     // The distributed driver's band: the whole mesh around it had every
     // round, the band only its first passes, so what they leave below the

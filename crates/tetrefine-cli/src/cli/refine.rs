@@ -66,9 +66,10 @@ pub struct Args {
     /// Minimum-sine quality below which vertices get optimization-based smoothing.
     #[arg(long, default_value_t = tetrefine::DEFAULT_THRESHOLD)]
     pub threshold: f64,
-    /// How hard the optimize phase works: fast (boundary fixed), default
-    /// (boundary vertices move inside their patch and along feature lines),
-    /// best (more passes, larger edge-removal rings, a higher bar).
+    /// How hard the optimize phase works: fast (boundary fixed, no long-edge
+    /// splits), default (boundary vertices move inside their patch and along
+    /// feature lines; two rounds split long edges), best (more passes, larger
+    /// edge-removal rings, a higher bar, three long-edge rounds).
     #[arg(long, default_value = "default")]
     pub effort: tetrefine::Effort,
     /// Hausdorff bound (MMG's -hausd): how far boundary moves may take the
