@@ -17,11 +17,12 @@ pub const LONG_EDGE_FACTOR: f64 = 1.4;
 /// [`LONG_EDGE_FACTOR`] times the mean at their ends, then settles the new
 /// balls with the passes. One round leaves edges that were not long against
 /// the means before it, and edges its settling flips make; a second round
-/// splits those. Measured on one default step (2026-12-06, against one
-/// round): 12 %–15 % more tets, average +1.4° to +1.9° (mmg_cube 44.23° →
-/// 46.14°, the tripod 47.63° → 49.05°), 99th-percentile edge −7 % to
-/// −17 %, longest edge −4 % to −13 % (mmg_cube's longest, a chord whose
-/// split is refused, stays), for 19 %–47 % more step time.
+/// splits those. Measured on one default step of the seven shipped meshes
+/// (2026-12-06, against one round): 11 %–16 % more tets, average +0.8° to
+/// +1.9° (mmg_cube 44.23° → 46.14°, the tripod 47.63° → 49.05°),
+/// 99th-percentile edge −7 % to −17 %, longest edge up to −13 % (mmg_cube's
+/// longest, a chord whose split is refused, stays), for 19 %–47 % more step
+/// time (+54 % on an already even cube grid).
 pub const LONG_EDGE_ROUNDS: usize = 2;
 
 /// How hard mesh improvement works.
