@@ -6,10 +6,10 @@
 //! 1. **Partition.** Rank 0 holds the input; METIS cuts its dual graph
 //!    ([`partition_dual_graph`]), each tet weighted by the tets it will
 //!    become (a selected tet of an adaptive run weighs
-//!    [`GROWTH_PER_STEP`] to the power of the steps). Each rank receives its tets as a self-contained
-//!    part: points, tags, regions, `level`, `parent` (global input ids), and
-//!    its cut faces as partition faces ([`crate::PartitionMarker`]) naming
-//!    the rank across.
+//!    [`GROWTH_PER_STEP`] to the power of the steps). Each rank receives
+//!    its tets as a self-contained part: points, tags, regions, `level`,
+//!    `parent` (global input ids), and its cut faces as partition faces
+//!    ([`crate::PartitionMarker`]) naming the rank across.
 //! 2. **Refine.** The serial step runs on every part. A partition face is
 //!    refined like a linear interface — split at its canonical centroid,
 //!    never flipped, never moved — so both sides create the same points

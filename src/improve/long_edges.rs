@@ -124,11 +124,11 @@ fn shell_qualities(mesh: &TetMesh, a: u32, b: u32, p: glam::DVec3, sh: &[u32]) -
 
 /// Splits every edge not on a partition face (nor, between two fixed
 /// vertices, at a pinch; see the module doc) longer than `factor` times the
-/// mean edge length at its two ends, longest first, at its midpoint. An edge is split only when every tet of its shell
-/// is in `zone` (per tet slot; `None`: every tet; the new tets join it) and
-/// when the worst of the new tets is at least the smaller of the shell's
-/// worst and `bar` (min sine), so the pass never lowers the worst tet below
-/// `bar`.
+/// mean edge length at its two ends, longest first, at its midpoint. An
+/// edge is split only when every tet of its shell is in `zone` (per tet
+/// slot; `None`: every tet; the new tets join it) and when the worst of the
+/// new tets is at least the smaller of the shell's worst and `bar` (min
+/// sine), so the pass never lowers the worst tet below `bar`.
 ///
 /// The candidates are found in parallel, with their shells and whether
 /// their splits would be kept, and split in one fixed order (length, then

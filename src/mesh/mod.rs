@@ -148,6 +148,21 @@ impl TetMesh {
         (0..self.tets.len() as u32).filter(move |&t| self.is_alive(t))
     }
 
+    /// Every edge of the live tets once, as [`edge_key`]s (lower id first),
+    /// sorted.
+    pub fn edges(&self) -> Vec<EdgeKey> {
+        let mut edges: Vec<EdgeKey> = self
+            .tet_ids()
+            .flat_map(|t| {
+                let v = self.tet(t);
+                TET_EDGES.map(|[i, j]| edge_key(v[i], v[j]))
+            })
+            .collect();
+        edges.sort_unstable();
+        edges.dedup();
+        edges
+    }
+
     // ----- accessors (each asserts its id, as geogram does) --------------------
 
     /// Debug check of a tet id: in range and, for `live`, not a dead slot.

@@ -26,7 +26,6 @@ use crate::geom::tet_min_sine;
 use crate::improve::{improve, ImproveOptions};
 use crate::mesh::TetMesh;
 use crate::ops::split_edge;
-use crate::topo::{edge_key, TET_EDGES};
 use glam::{DMat3, DVec3};
 
 /// Metric length above which an edge is split. Splitting an edge of length
@@ -328,16 +327,8 @@ pub(crate) fn without_insertion(o: &ImproveOptions) -> ImproveOptions {
 
 /// The long edges of `mesh`, longest first (ties by vertex ids).
 pub fn long_edges(mesh: &TetMesh, size: &SizeMap) -> Vec<(f64, [u32; 2])> {
-    let mut edges: Vec<[u32; 2]> = mesh
-        .tet_ids()
-        .flat_map(|t| {
-            let v = mesh.tet(t);
-            TET_EDGES.map(|[i, j]| edge_key(v[i], v[j]))
-        })
-        .collect();
-    edges.sort_unstable();
-    edges.dedup();
-    let mut long: Vec<(f64, [u32; 2])> = edges
+    let mut long: Vec<(f64, [u32; 2])> = mesh
+        .edges()
         .into_iter()
         .map(|[a, b]| (size.edge_length(a, b, mesh.point(a), mesh.point(b)), [a, b]))
         .filter(|&(l, _)| l > SPLIT_ABOVE)

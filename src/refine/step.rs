@@ -347,7 +347,7 @@ fn step_phases(
 
 /// Phase 6: edge removal and smoothing, then (at the efforts that have them)
 /// the long-edge rounds, each with its settling passes, over the zone
-/// `--smooth` allows. Also run, without the long-edge round
+/// `--smooth` allows. Also run, without the long-edge rounds
 /// (`long_edges`) and over the band the cut froze (`zone`: per point, may
 /// it move; per tet slot, may its edges go), by the distributed driver once
 /// the cut has moved.
@@ -397,28 +397,29 @@ pub(crate) fn optimize_phase(
     // passes with edge removal up to a higher bar settle the new
     // balls; the effort sets how many such rounds run.
     let mut report = improve(mesh, &io);
-    let factor = opts.effort.long_edge_factor().filter(|_| long_edges);
-    for factor in std::iter::repeat_n(factor, opts.effort.long_edge_rounds()).flatten() {
-        // The passes before created and removed tets: the
-        // zone is gathered again.
-        let (movable, tet_allowed) = smoothing_zone(mesh, step, opts);
-        let io = ImproveOptions {
-            movable,
-            tet_allowed,
-            long_edge_factor: Some(factor),
-            // Only edges of this step's tets: an adaptive
-            // step leaves the rest of the mesh at its size.
-            long_edge_zone: Some(descendants_of_last_step(mesh, step)),
-            edge_threshold: io.edge_threshold.max(SETTLE_EDGE_THRESHOLD),
-            // The boundary stays where the first passes left
-            // it, so `--hausd` bounds the whole step's drift
-            // (moving it again would measure from the moved
-            // surface); this costs 0.1°–0.2° of average.
-            boundary: None,
-            ..io
-        };
-        let settled = improve(mesh, &io);
-        report.add(&settled);
+    if let Some(factor) = opts.effort.long_edge_factor().filter(|_| long_edges) {
+        for _ in 0..opts.effort.long_edge_rounds() {
+            // The passes before created and removed tets: the
+            // zone is gathered again.
+            let (movable, tet_allowed) = smoothing_zone(mesh, step, opts);
+            let io = ImproveOptions {
+                movable,
+                tet_allowed,
+                long_edge_factor: Some(factor),
+                // Only edges of this step's tets: an adaptive
+                // step leaves the rest of the mesh at its size.
+                long_edge_zone: Some(descendants_of_last_step(mesh, step)),
+                edge_threshold: io.edge_threshold.max(SETTLE_EDGE_THRESHOLD),
+                // The boundary stays where the first passes left
+                // it, so `--hausd` bounds the whole step's drift
+                // (moving it again would measure from the moved
+                // surface); this costs 0.1°–0.2° of average.
+                boundary: None,
+                ..io
+            };
+            let settled = improve(mesh, &io);
+            report.add(&settled);
+        }
     }
     // The distributed driver's band: the whole mesh around it had every
     // round, the band only its first passes, so what they leave below the

@@ -160,30 +160,25 @@ fn a_default_step_evens_out_edge_lengths() {
 /// The longest edge of `mesh`, and the share of its edges longer than 1.4
 /// times the mean length of the edges at their two ends.
 fn edge_spread(mesh: &tetrefine::TetMesh) -> (f64, f64) {
-    let mut edges: Vec<[u32; 2]> = mesh
-        .tet_ids()
-        .flat_map(|t| {
-            let v = mesh.tet(t);
-            [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)]
-                .map(|(i, j)| [v[i].min(v[j]), v[i].max(v[j])])
-        })
+    let edges = mesh.edges();
+    let lengths: Vec<f64> = edges
+        .iter()
+        .map(|&[a, b]| (mesh.point(a) - mesh.point(b)).length())
         .collect();
-    edges.sort_unstable();
-    edges.dedup();
-    let length = |[a, b]: [u32; 2]| (mesh.point(a) - mesh.point(b)).length();
     let mut sum = vec![0.0; mesh.n_points()];
     let mut count = vec![0usize; mesh.n_points()];
-    for &e in &edges {
-        for v in e {
-            sum[v as usize] += length(e);
+    for (e, &l) in edges.iter().zip(&lengths) {
+        for &v in e {
+            sum[v as usize] += l;
             count[v as usize] += 1;
         }
     }
     let mean = |v: u32| sum[v as usize] / count[v as usize] as f64;
-    let longest = edges.iter().map(|&e| length(e)).fold(0.0, f64::max);
+    let longest = lengths.iter().copied().fold(0.0, f64::max);
     let out = edges
         .iter()
-        .filter(|&&[a, b]| length([a, b]) > 1.4 * 0.5 * (mean(a) + mean(b)))
+        .zip(&lengths)
+        .filter(|&(&[a, b], &l)| l > 1.4 * 0.5 * (mean(a) + mean(b)))
         .count();
     (longest, out as f64 / edges.len() as f64)
 }
