@@ -1,13 +1,15 @@
 //! Building a [`TetMesh`] from [`MeshData`]: validation, orientation and face
 //! adjacency by bucketing half-faces on their smallest vertex (parallel).
 
-use super::{edge_key, face_key, MeshData, TetMesh, NO_ADJ};
+use super::fasthash::{FastHashMap, FastHashSet};
+use super::{
+    edge_key, edges_present, face_key, faces_present, EdgeKey, FaceKey, MeshData, TetMesh, NO_ADJ,
+};
 use crate::geom::{orient3d_sign, Orientation};
 use crate::topo::scatter::Shared;
 use crate::topo::TET_FACES;
 use glam::DVec3;
 use rayon::prelude::*;
-use std::collections::{HashMap, HashSet};
 use std::fmt;
 use std::sync::atomic::{AtomicU32, Ordering};
 
@@ -350,15 +352,9 @@ impl TetMesh {
             check("vertex tag", v)?;
         }
         if !data.triangles.is_empty() {
-            let faces: HashSet<[u32; 3]> = self
-                .tets
-                .iter()
-                .flat_map(|v| {
-                    TET_FACES
-                        .iter()
-                        .map(move |l| face_key([v[l[0]], v[l[1]], v[l[2]]]))
-                })
-                .collect();
+            let wanted: FastHashSet<FaceKey> =
+                data.triangles.iter().map(|&(f, _)| face_key(f)).collect();
+            let faces = faces_present(&self.tets, &wanted);
             for &(f, m) in &data.triangles {
                 let k = face_key(f);
                 if faces.contains(&k) {
@@ -369,16 +365,13 @@ impl TetMesh {
             }
         }
         if !data.edges.is_empty() {
-            let edges: HashSet<[u32; 2]> = self
-                .tets
+            let wanted: FastHashSet<EdgeKey> = data
+                .edges
                 .iter()
-                .flat_map(|v| {
-                    crate::topo::TET_EDGES
-                        .iter()
-                        .map(move |e| edge_key(v[e[0]], v[e[1]]))
-                })
+                .map(|&([a, b], _)| edge_key(a, b))
                 .collect();
-            let mut tagged = crate::mesh::fasthash::FastHashMap::default();
+            let edges = edges_present(&self.tets, &wanted);
+            let mut tagged = FastHashMap::default();
             for &([a, b], m) in &data.edges {
                 let k = edge_key(a, b);
                 if edges.contains(&k) {
@@ -402,7 +395,7 @@ impl TetMesh {
             self.face_markers.iter().map(|(k, &m)| (*k, m)).collect();
         // Boundary faces are written with their outward orientation, as Medit
         // and Gmsh expect; interface faces keep their sorted order.
-        let outward: HashMap<[u32; 3], [u32; 3]> = ids
+        let outward: FastHashMap<[u32; 3], [u32; 3]> = ids
             .iter()
             .flat_map(|&t| {
                 (0..4)
@@ -563,6 +556,7 @@ fn match_half_faces(
 mod tests {
     use super::*;
     use crate::mesh::generate::cube_grid;
+    use std::collections::HashMap;
 
     /// Adjacency by a hash map from sorted face to its half-faces: the
     /// plain definition `match_half_faces` must agree with.

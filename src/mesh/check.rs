@@ -1,10 +1,11 @@
 //! [`TetMesh::check`]: verifies every invariant of the store.
 
-use super::{edge_key, face_key, TetMesh, DEAD, NO_ADJ};
+use super::fasthash::{FastHashMap, FastHashSet};
+use super::{
+    edge_key, edges_present, face_key, faces_present, EdgeKey, FaceKey, TetMesh, DEAD, NO_ADJ,
+};
 use crate::geom::{orient3d_sign, Orientation};
-use crate::topo::{TET_EDGES, TET_FACES};
 use rayon::prelude::*;
-use std::collections::{HashMap, HashSet};
 
 /// An invariant that does not hold. Ids are the store's 0-based ids.
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
@@ -151,8 +152,8 @@ impl TetMesh {
             return Err(CheckError::VertexTet(x));
         }
 
-        // Boundary manifoldness and tag consistency need the face and edge sets.
-        let mut boundary_edge_count: HashMap<[u32; 2], usize> = HashMap::new();
+        // Boundary manifoldness: the boundary faces' edges, counted.
+        let mut boundary_edge_count: FastHashMap<[u32; 2], usize> = FastHashMap::default();
         for t in self.tet_ids() {
             for f in 0..4 {
                 if self.adj[t as usize][f] == NO_ADJ {
@@ -170,15 +171,8 @@ impl TetMesh {
             return Err(CheckError::NonManifoldBoundary(*e, c));
         }
         if !self.face_markers.is_empty() {
-            let faces: HashSet<[u32; 3]> = self
-                .tet_ids()
-                .flat_map(|t| {
-                    let v = self.tets[t as usize];
-                    TET_FACES
-                        .iter()
-                        .map(move |l| face_key([v[l[0]], v[l[1]], v[l[2]]]))
-                })
-                .collect();
+            let wanted: FastHashSet<FaceKey> = self.face_markers.keys().copied().collect();
+            let faces = faces_present(&self.tets, &wanted);
             if let Some(f) = self.face_markers.keys().find(|f| !faces.contains(*f)) {
                 return Err(CheckError::Tag(format!(
                     "marked face {f:?} is not a face of the mesh"
@@ -186,13 +180,8 @@ impl TetMesh {
             }
         }
         if !self.feature_edges.is_empty() {
-            let edges: HashSet<[u32; 2]> = self
-                .tet_ids()
-                .flat_map(|t| {
-                    let v = self.tets[t as usize];
-                    TET_EDGES.iter().map(move |e| edge_key(v[e[0]], v[e[1]]))
-                })
-                .collect();
+            let wanted: FastHashSet<EdgeKey> = self.feature_edges.keys().copied().collect();
+            let edges = edges_present(&self.tets, &wanted);
             if let Some(e) = self.feature_edges.keys().find(|e| !edges.contains(*e)) {
                 return Err(CheckError::Tag(format!(
                     "feature edge {e:?} is not an edge of the mesh"

@@ -810,6 +810,45 @@ impl TetMesh {
     }
 }
 
+/// The keys of `wanted` that are faces of the live tets of `tets`. The
+/// tets' faces are looked up in `wanted` (a mesh's tags: thousands of keys)
+/// in parallel, rather than gathered into a set of every face: tens of
+/// millions of keys on a refined mesh, hashed on one thread, for each
+/// `check` and each mesh built from data.
+pub(crate) fn faces_present(
+    tets: &[[u32; 4]],
+    wanted: &FastHashSet<FaceKey>,
+) -> FastHashSet<FaceKey> {
+    tets.par_iter()
+        .with_min_len(4096)
+        .filter(|v| v[0] != DEAD)
+        .flat_map_iter(|v| {
+            TET_FACES
+                .iter()
+                .map(move |l| face_key([v[l[0]], v[l[1]], v[l[2]]]))
+        })
+        .filter(|k| wanted.contains(k))
+        .collect::<Vec<_>>()
+        .into_iter()
+        .collect()
+}
+
+/// The keys of `wanted` that are edges of the live tets of `tets` (as
+/// [`faces_present`] for faces).
+pub(crate) fn edges_present(
+    tets: &[[u32; 4]],
+    wanted: &FastHashSet<EdgeKey>,
+) -> FastHashSet<EdgeKey> {
+    tets.par_iter()
+        .with_min_len(4096)
+        .filter(|v| v[0] != DEAD)
+        .flat_map_iter(|v| TET_EDGES.iter().map(move |e| edge_key(v[e[0]], v[e[1]])))
+        .filter(|k| wanted.contains(k))
+        .collect::<Vec<_>>()
+        .into_iter()
+        .collect()
+}
+
 /// Tet slots claimed by [`TetMesh::claim_slots`]: the `j`-th is
 /// [`NewSlots::get`]`(j)`.
 #[derive(Clone, Debug)]

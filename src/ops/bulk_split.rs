@@ -55,6 +55,13 @@ fn children_positive(points: &[DVec3], v: [u32; 4], c: DVec3) -> bool {
     }))
 }
 
+/// Whether a selection (per tet slot; `None`: every slot) selects slot `t`;
+/// a slot past the selection's end is not selected. The one reading of
+/// a refinement step's selection, for the split and the step's counts.
+pub(crate) fn is_selected(selection: Option<&[bool]>, t: usize) -> bool {
+    selection.is_none_or(|s| s.get(t).copied().unwrap_or(false))
+}
+
 /// 1-4 splits every live tet whose slot is selected (`None`: every tet) at
 /// its barycentre, raising the children's `level` by one (saturating) and
 /// keeping region and parent. A split that would create a non-positive child
@@ -74,7 +81,7 @@ pub fn split14_bulk(mesh: &mut TetMesh, selection: Option<&[bool]>) -> usize {
             .map(|t| {
                 let v = tets[t];
                 v[0] != DEAD
-                    && selection.is_none_or(|s| s.get(t).copied().unwrap_or(false))
+                    && is_selected(selection, t)
                     && children_positive(points, v, barycentre(points, v))
             })
             .collect()

@@ -297,6 +297,12 @@ pub(crate) fn apply_face_removal(
     plan: &FacePlan,
 ) -> Result<FaceRemoval, OpError> {
     debug_assert!(plan.is_current(mesh));
+    // The walk sees only the piece of u's ball its first tet is in (at a
+    // pinch, where pieces of the domain touch at u, not the others). That
+    // is enough: the new tets all hold u–w and close around it, so the
+    // open segment u–w lies inside the cavity, which no tet of another
+    // piece overlaps; an edge u–w there would cross a cavity tet. The
+    // walk is a guard, as cheap as one ball.
     let mut ball = Vec::new();
     mesh.ball(plan.u, &mut ball);
     if ball.iter().any(|&b| mesh.tet(b).contains(&plan.w)) {

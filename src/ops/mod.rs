@@ -28,6 +28,7 @@ use crate::topo::TET_FACES;
 
 pub use boundary_flip::{boundary_flip_ring, flip_boundary_edge, BoundaryFlipLimits, TetsAtVertex};
 pub use bulk_flip::{flip23_bulk, FlipBatch};
+pub(crate) use bulk_split::is_selected;
 pub use bulk_split::split14_bulk;
 pub use cap_removal::{is_cap_below, remove_boundary_cap, CapLimits};
 pub use edge_contraction::{contract_boundary_edge, contract_edge};

@@ -7,7 +7,7 @@ use crate::mesh::fasthash::FastHashMap;
 use crate::mesh::partition::{canonical_centroid, partition_edges, PartitionMarker};
 use crate::mesh::{edge_key, TetMarks, TetMesh, NO_ADJ};
 use crate::ops::{
-    flip23_bulk, make_flips_valid, remove_edge, remove_interface_edge, split14_bulk,
+    flip23_bulk, is_selected, make_flips_valid, remove_edge, remove_interface_edge, split14_bulk,
     split_boundary_face, split_interface_face, trisect_edge, EdgeRing, FlipBatch,
 };
 use crate::stencil::sqrt3_positions_trisecting;
@@ -62,12 +62,10 @@ pub fn refine_with_guard<E>(
         if s > 1 && opts.selection.is_some() {
             step_opts.selection = Some(descendants_of_last_step(mesh, s - 1));
         }
-        let split = match &step_opts.selection {
-            Some(sel) => (0..mesh.n_tet_slots() as u32)
-                .filter(|&t| mesh.is_alive(t) && sel.get(t as usize).copied().unwrap_or(false))
-                .count(),
-            None => mesh.n_tets(),
-        };
+        let sel = step_opts.selection.as_deref();
+        let split = (0..mesh.n_tet_slots())
+            .filter(|&t| mesh.is_alive(t as u32) && is_selected(sel, t))
+            .count();
         before_step(s, mesh, split as u64)?;
         let report = step_keeping(mesh, s, &step_opts, progress, keep.filter(|_| s > 1));
         on_step(s, mesh, report);
@@ -163,13 +161,8 @@ fn step_keeping(
     let input = keeps.then(|| mesh.clone());
     let mut report = step_phases(mesh, step, opts, progress, floor);
     if let Some(input) = input {
-        let selected = |t: usize| {
-            input.is_alive(t as u32)
-                && opts
-                    .selection
-                    .as_ref()
-                    .is_none_or(|s| s.get(t) == Some(&true))
-        };
+        let selected =
+            |t: usize| input.is_alive(t as u32) && is_selected(opts.selection.as_deref(), t);
         let n_selected = (0..input.n_tet_slots()).filter(|&t| selected(t)).count();
         let mut held = vec![false; input.n_tet_slots()];
         // The last attempt, which missed `keep` but had the highest worst
