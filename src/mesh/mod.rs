@@ -810,42 +810,45 @@ impl TetMesh {
     }
 }
 
-/// The keys of `wanted` that are faces of the live tets of `tets`. The
-/// tets' faces are looked up in `wanted` (a mesh's tags: thousands of keys)
-/// in parallel, rather than gathered into a set of every face: tens of
-/// millions of keys on a refined mesh, hashed on one thread, for each
-/// `check` and each mesh built from data.
+/// The keys of `wanted` that are faces of the live tets of `tets`.
 pub(crate) fn faces_present(
     tets: &[[u32; 4]],
     wanted: &FastHashSet<FaceKey>,
 ) -> FastHashSet<FaceKey> {
-    tets.par_iter()
-        .with_min_len(4096)
-        .filter(|v| v[0] != DEAD)
-        .flat_map_iter(|v| {
-            TET_FACES
-                .iter()
-                .map(move |l| face_key([v[l[0]], v[l[1]], v[l[2]]]))
-        })
-        .filter(|k| wanted.contains(k))
-        .collect::<Vec<_>>()
-        .into_iter()
-        .collect()
+    keys_present(tets, wanted, |v| {
+        TET_FACES.map(|l| face_key([v[l[0]], v[l[1]], v[l[2]]]))
+    })
 }
 
-/// The keys of `wanted` that are edges of the live tets of `tets` (as
-/// [`faces_present`] for faces).
+/// The keys of `wanted` that are edges of the live tets of `tets`.
 pub(crate) fn edges_present(
     tets: &[[u32; 4]],
     wanted: &FastHashSet<EdgeKey>,
 ) -> FastHashSet<EdgeKey> {
+    keys_present(tets, wanted, |v| {
+        TET_EDGES.map(|[i, j]| edge_key(v[i], v[j]))
+    })
+}
+
+/// The keys of `wanted` among the keys (faces or edges) `keys_of` gives
+/// for each live tet of `tets`. Each tet's keys are looked up in `wanted`
+/// (a mesh's tags: thousands of keys) in parallel, rather than gathered
+/// into a set of every face or edge: tens of millions of keys on a refined
+/// mesh, hashed on one thread, for each `check` and each mesh built from
+/// data.
+fn keys_present<K, const N: usize>(
+    tets: &[[u32; 4]],
+    wanted: &FastHashSet<K>,
+    keys_of: fn(&[u32; 4]) -> [K; N],
+) -> FastHashSet<K>
+where
+    K: Copy + Eq + std::hash::Hash + Send + Sync,
+{
     tets.par_iter()
         .with_min_len(4096)
         .filter(|v| v[0] != DEAD)
-        .flat_map_iter(|v| TET_EDGES.iter().map(move |e| edge_key(v[e[0]], v[e[1]])))
+        .flat_map_iter(keys_of)
         .filter(|k| wanted.contains(k))
-        .collect::<Vec<_>>()
-        .into_iter()
         .collect()
 }
 

@@ -141,8 +141,8 @@ fn feature_segments(m: &TetMesh) -> Vec<[DVec3; 2]> {
 
 /// Two steps as one run (`--steps 2`: the second keeps the input's worst,
 /// not the first step's, so it does not run again holding tets back; run
-/// as two single steps, mmg_tinyBoxt's 5M-tet second step ran up to five
-/// times), with `check()` after every phase.
+/// as two single steps, mmg_tinyBoxt's 5M-tet second step ran twice),
+/// with `check()` after every phase.
 fn two_steps(m: &mut TetMesh, rule: Sqrt3Rule) {
     let opts = RefineOptions {
         boundary: rule,

@@ -29,7 +29,7 @@ fn two_steps(name: &str, rule: Sqrt3Rule, features: bool) {
     };
     // One run of two steps, as `--steps 2` (a second single step would
     // keep the first's worst, and run again holding tets back when it
-    // cannot: up to five times on mmg_tinyBoxt's 5M-tet second step).
+    // cannot: mmg_tinyBoxt's 5M-tet second step ran twice).
     let mut steps = 0;
     refine_with(&mut mesh, 2, &opts, &NoProgress, |step, mesh, r| {
         assert!(
