@@ -394,7 +394,12 @@ pub fn improve(mesh: &mut TetMesh, opts: &ImproveOptions) -> ImproveReport {
         .as_ref()
         .map(|b| BoundarySmoother::new(mesh, b.clone()));
     // Past `opts.passes`, a pass runs only while a tet is below the floor
-    // and the one before raised the worst of those that may change.
+    // and, from the second such pass on, the one before raised the worst
+    // of those that may change: the first always runs. Checking the last
+    // of `opts.passes` too was measured (two default steps, 2026-12-06):
+    // 7 % less time on mmg_tinyBoxt's and gmsh_t16's second steps, but
+    // 0.2° less average, and mmg_tinyBoxt's worst fell from 17.20° to
+    // 16.80° (the passes it skipped, for the mean, helped the rescue).
     let mut worst = f64::NEG_INFINITY;
     for pass in 0..opts.passes + FLOOR_PASSES {
         if pass >= opts.passes {
