@@ -51,6 +51,9 @@ pub(crate) struct InsertionScratch {
     ball: BallPoints,
     qualities: Vec<f64>,
     trial: Vec<f64>,
+    /// The vertices the last [`plan_insertion`] read: the tet's and its
+    /// edges' ring vertices, with repeats.
+    pub read: Vec<u32>,
 }
 
 /// The best split of an edge of tet `t` whose new vertex raises the worst
@@ -69,9 +72,12 @@ pub(crate) fn plan_insertion(
 ) -> Option<InsertionPlan> {
     let mut best: Option<InsertionPlan> = None;
     let region = mesh.region(t);
+    s.read.clear();
+    s.read.extend(mesh.tet(t));
     for e in 0..6 {
         s.ring.gather_into(mesh, t, e);
         let ring = &s.ring;
+        s.read.extend(&ring.verts);
         if !ring.closed
             || mesh.feature_edge(ring.a, ring.b).is_some()
             || ring

@@ -33,7 +33,7 @@ use crate::topo::scatter::Shared;
 use crate::topo::{EDGE_OF, TET_EDGES};
 use glam::DVec3;
 use rayon::prelude::*;
-use std::sync::atomic::{AtomicBool, AtomicU8, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU64, AtomicU8, Ordering};
 
 /// Options of [`improve`].
 #[derive(Clone, Debug)]
@@ -192,6 +192,12 @@ struct Tracker {
     vert_dirty: Vec<AtomicBool>,
     /// Tet slots whose edges may be removed.
     allowed: Option<Vec<bool>>,
+    /// Per vertex, the `clock` reading when a tet holding it last changed
+    /// (was created, removed, or had a vertex moved); atomic for the same
+    /// reason as `vert_dirty`.
+    changed_at: Vec<AtomicU64>,
+    /// Advanced by [`Tracker::tick`]; changes are stamped with its reading.
+    clock: u64,
 }
 
 impl Tracker {
@@ -215,7 +221,34 @@ impl Tracker {
                 .map(|_| AtomicBool::new(true))
                 .collect(),
             allowed,
+            changed_at: (0..mesh.n_points())
+                .into_par_iter()
+                .map(|_| AtomicU64::new(0))
+                .collect(),
+            clock: 1,
         }
+    }
+
+    /// A reading of the clock later than every stamp so far and earlier
+    /// than every stamp to come: whatever reads only vertices whose stamps
+    /// are below it has seen nothing change since.
+    fn tick(&mut self) -> u64 {
+        self.clock += 2;
+        self.clock - 1
+    }
+
+    /// Stamps vertex `v` as changed now.
+    fn touch(&mut self, v: u32) {
+        *self.vert_dirty[v as usize].get_mut() = true;
+        *self.changed_at[v as usize].get_mut() = self.clock;
+    }
+
+    /// Whether no tet holding a vertex of `verts` changed since `at` (a
+    /// reading of [`Tracker::tick`]).
+    fn unchanged_since(&self, verts: impl IntoIterator<Item = u32>, at: u64) -> bool {
+        verts
+            .into_iter()
+            .all(|v| self.changed_at[v as usize].load(Ordering::Relaxed) < at)
     }
 
     fn grow(&mut self, slots: usize) {
@@ -233,7 +266,7 @@ impl Tracker {
         self.tq[t as usize] = q;
         self.tet_dirty[t as usize] = true;
         for v in mesh.tet(t) {
-            *self.vert_dirty[v as usize].get_mut() = true;
+            self.touch(v);
         }
     }
 
@@ -244,6 +277,9 @@ impl Tracker {
         if self.vert_dirty.len() < mesh.n_points() {
             self.vert_dirty
                 .resize_with(mesh.n_points(), || AtomicBool::new(true));
+            let now = self.clock;
+            self.changed_at
+                .resize_with(mesh.n_points(), || AtomicU64::new(now));
         }
         for &x in removed {
             self.tq[x as usize] = f64::INFINITY;
@@ -384,6 +420,7 @@ pub fn improve(mesh: &mut TetMesh, opts: &ImproveOptions) -> ImproveReport {
         f64::INFINITY
     };
     let mut edges = EdgeRemoval::default();
+    let mut refused = FastHashMap::default();
     // Caps go before the smoother takes the boundary as its reference, and
     // again after the passes for those the passes left.
     if let Some(b) = &opts.boundary {
@@ -416,7 +453,14 @@ pub fn improve(mesh: &mut TetMesh, opts: &ImproveOptions) -> ImproveReport {
             changed += contract_pass(mesh, &mut tr, &mut movable, None, opts, &mut report);
         }
         if opts.insert_vertices && pass >= INSERT_FROM_PASS {
-            changed += insert_pass(mesh, &mut tr, &mut movable, &mut zone, opts, &mut report);
+            changed += insert_pass(
+                mesh,
+                &mut tr,
+                (&mut movable, &mut zone),
+                &mut refused,
+                opts,
+                &mut report,
+            );
         }
         changed += smooth_pass(mesh, &mut tr, &movable, opts, keep, &mut report);
         if let Some(s) = &surface {
@@ -698,16 +742,37 @@ fn contract_pass(
 /// a knife edge this constant does not remove.
 const INSERT_FROM_PASS: usize = 2;
 
+/// A tet where [`plan_insertion`] found no split: what it read, and when.
+struct Refusal {
+    /// The tet slot's generation then.
+    generation: u32,
+    /// A [`Tracker::tick`] reading taken just before.
+    at: u64,
+    /// The vertices the search read.
+    read: Vec<u32>,
+}
+
 /// Vertex insertions ([`plan_insertion`]) at the tets still below
 /// `opts.threshold`, in slot order, each on the edge of the tet whose split,
 /// with the new vertex placed by the optimiser, best raises the worst tet of
 /// the edge's shell. The new vertices are interior and may move (they join
 /// `movable` and `zone`). Returns the number of insertions.
+///
+/// A tet with no split found is recorded in `refused`, and an earlier
+/// pass's record stands in for the search while no tet holding a vertex
+/// the search read has changed: the search reads only those vertices'
+/// positions, the shells of the tet's edges and those tets' tags and
+/// permissions, and every operation that changes the shell of an edge of
+/// the tet either removes the tet (its slot's generation moves on) or
+/// makes or removes a tet holding the edge's ends, which stamps them. So
+/// the result is the one of searching again. Measured on two default steps of mmg_tinyBoxt: 1.9 s
+/// less of 77.6 s, the output byte for byte the same; the last round's ten
+/// passes searched the same few hundred tets again each time.
 fn insert_pass(
     mesh: &mut TetMesh,
     tr: &mut Tracker,
-    movable: &mut Vec<bool>,
-    zone: &mut Vec<bool>,
+    (movable, zone): (&mut Vec<bool>, &mut Vec<bool>),
+    refused: &mut FastHashMap<u32, Refusal>,
     opts: &ImproveOptions,
     report: &mut ImproveReport,
 ) -> usize {
@@ -719,7 +784,24 @@ fn insert_pass(
         if !mesh.is_alive(t) || q >= opts.threshold {
             continue;
         }
+        if let Some(r) = refused.get(&t) {
+            if r.generation == mesh.generation(t)
+                && tr.unchanged_since(r.read.iter().copied(), r.at)
+            {
+                continue;
+            }
+        }
+        let at = tr.tick();
         let Some(plan) = plan_insertion(mesh, t, q, |x| tr.is_allowed(x), &mut scratch) else {
+            let read = std::mem::take(&mut scratch.read);
+            refused.insert(
+                t,
+                Refusal {
+                    generation: mesh.generation(t),
+                    at,
+                    read,
+                },
+            );
             continue;
         };
         if let Ok((m, new)) = split_edge(mesh, plan.a, plan.b, plan.x) {
@@ -843,7 +925,7 @@ fn cap_pass(
         if remove_boundary_cap(mesh, t, limits).is_ok() {
             tr.tq[t as usize] = f64::INFINITY;
             for v in verts {
-                *tr.vert_dirty[v as usize].get_mut() = true;
+                tr.touch(v);
             }
             removed += 1;
         }
@@ -1396,7 +1478,7 @@ fn apply_moves(
     let mesh = &*mesh;
     let tq = Shared::new(&mut tr.tq);
     let tet_dirty = Shared::new(&mut tr.tet_dirty);
-    let vert_dirty = &tr.vert_dirty;
+    let (vert_dirty, changed_at, now) = (&tr.vert_dirty, &tr.changed_at, tr.clock);
     group
         .par_iter()
         .zip(moves.par_iter())
@@ -1409,6 +1491,7 @@ fn apply_moves(
                 tet_dirty.set(t as usize, true);
                 for v in mesh.tet(t) {
                     vert_dirty[v as usize].store(true, Ordering::Relaxed);
+                    changed_at[v as usize].store(now, Ordering::Relaxed);
                 }
             }
         });
@@ -1480,5 +1563,33 @@ mod tests {
         m.compact();
         m.check().expect("a valid mesh after compaction");
         assert!((volume(&m) - exact).abs() < 1e-12, "volume {}", volume(&m));
+    }
+
+    #[test]
+    fn the_tracker_stamps_the_corners_of_what_changes_after_a_tick() {
+        // A Kuhn grid of 2×2×2 cells: 27 points, 48 tets.
+        let m = TetMesh::from_data(&crate::mesh::generate::cube_grid(2))
+            .expect("a cube")
+            .0;
+        assert_eq!((m.n_points(), m.n_tets()), (27, 48));
+        let mut tr = Tracker::new(&m, None);
+        let all = || 0..m.n_points() as u32;
+        let at = tr.tick();
+        assert!(tr.unchanged_since(all(), at), "nothing changed yet");
+        let t = m.tet_ids().next().expect("a tet");
+        let q = tr.tq[t as usize];
+        tr.set(&m, t, q);
+        let corners = m.tet(t);
+        for v in all() {
+            assert_eq!(
+                tr.unchanged_since([v], at),
+                !corners.contains(&v),
+                "point {v}"
+            );
+        }
+        // A later reading sees the change as past.
+        let later = tr.tick();
+        assert!(tr.unchanged_since(all(), later));
+        assert!(!tr.unchanged_since(corners, at));
     }
 }
