@@ -935,8 +935,9 @@ fn cap_pass(
 }
 
 /// Boundary smoothing of the dirty surface and line vertices (allowed by
-/// `opts.movable`) whose worst tet is below the Laplacian bar, one by one in
-/// vertex order. Returns the number of vertices moved.
+/// `opts.movable`) whose worst tet is below the Laplacian bar, by colour
+/// classes ([`BoundarySmoother::pass`]). Returns the number of vertices
+/// moved.
 fn boundary_pass(
     mesh: &mut TetMesh,
     tr: &mut Tracker,
