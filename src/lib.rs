@@ -11,10 +11,10 @@
 //! The crate root re-exports what a library user needs: reading and writing
 //! meshes ([`load_mesh`], [`read_mesh`], [`write_mesh`]), the store
 //! ([`TetMesh`]: read access and checked operations; the primitives that
-//! could break its invariants are crate-private), refinement ([`refine`],
+//! could break its invariants are crate-private), refinement ([`refine`](fn@refine),
 //! [`refine_with`] with a per-step callback, [`RefineOptions`],
 //! [`StepReport`]), marking ([`MarkStrategy`], [`select`]), improvement
-//! ([`improve`]) and statistics ([`MeshStats`], [`format_table`]). TetGen is
+//! ([`improve`](fn@improve)) and statistics ([`MeshStats`], [`format_table`]). TetGen is
 //! behind the `tetgen` feature.
 //!
 //! ```

@@ -2,7 +2,7 @@
 //! after a step the edges of the input stand out among the new ones (on the
 //! tripod the longest edge is 3.6 times the mean). An edge much longer than
 //! the edges around it is split at its midpoint by the shell split of
-//! [`split_edge`], the way MMG3D's size-driven remeshing and Rivara's
+//! [`split_edge`](crate::ops::split_edge), the way MMG3D's size-driven remeshing and Rivara's
 //! longest-edge bisection split edges; the smoothing and edge removal that
 //! follow then even out the new vertex's ball.
 //!

@@ -58,7 +58,7 @@ fn with_stamps<R>(n_points: usize, v: u32, f: impl FnOnce(&mut [u32], u32) -> R)
 /// The corners of every tet of a vertex's ball, loaded once, so that the
 /// ball's qualities with the vertex at trial positions need no lookups in the
 /// mesh. Each evaluation computes exactly what `mesh::moves::tet_points_with` followed by
-/// [`tet_min_sine`] (or [`orient3d`]) computes.
+/// [`tet_min_sine`] (or [`orient3d`](crate::geom::orient3d)) computes.
 #[derive(Clone, Debug, Default)]
 pub struct BallPoints {
     /// Corners of each ball tet, as stored in the mesh.

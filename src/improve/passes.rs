@@ -644,9 +644,10 @@ const CONTRACT_FROM_PASS: usize = 1;
 /// (after a step, a new point crowded against the boundary) keeps that
 /// edge through every flip and smoothing move; only the contraction takes
 /// it out. With `boundary_zone` (the vertices the caller lets change) the
-/// merged vertices are the fixed ones instead, each on a flat piece of the
-/// boundary ([`crate::ops::contract_flat_boundary_edge`], which refuses
-/// every other kind): a sliver with four boundary corners on a plane.
+/// merged vertices are the fixed ones instead, each along the boundary
+/// within one patch ([`crate::ops::contract_boundary_edge`]: a flat star
+/// under the linear rule, else within the crease angle and the Hausdorff
+/// bound): a sliver with four boundary corners on a plane.
 /// Returns the number of contractions.
 fn contract_pass(
     mesh: &mut TetMesh,

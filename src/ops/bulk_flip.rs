@@ -25,7 +25,7 @@
 //! an unflipped neighbour (refused flip, unsplit tet, constrained face) gets
 //! its one facing adjacency entry rewritten by the one task that faces it.
 //!
-//! The result equals calling [`super::flip23`] on the faces in order (same
+//! The result equals calling [`super::flip23`](fn@super::flip23) on the faces in order (same
 //! slots, generations and vertex → tet entries). Seed paper §3.1 (Figure 5).
 
 use crate::geom::all_positive;

@@ -20,7 +20,7 @@
 //! Slots and point ids come from a prefix sum over the selected tets; the
 //! claimed slots are the free list first (from its end, as
 //! [`TetMesh::alloc_tet`] pops it) then new slots reserved exactly at the end.
-//! The result equals calling [`super::split14`] on the selected tets in
+//! The result equals calling [`super::split14`](fn@super::split14) on the selected tets in
 //! ascending order (same slots, points, generations, vertex → tet entries).
 //!
 //! Seed paper (Burkhart, Hamann, Umlauf 2010) §3.1; the parallel scheme

@@ -1,4 +1,4 @@
-//! The phases of one √3 step (see the module docs of [`crate::refine`]).
+//! The phases of one √3 step (see the module docs of [`crate::refine`](mod@crate::refine)).
 
 use super::{InterfaceRule, NoProgress, Phase, PhaseReport, Progress, RefineOptions, StepReport};
 use crate::improve::{improve, ImproveOptions};

@@ -137,7 +137,7 @@ pub struct MeshStats {
 }
 
 /// Whether a tet with float determinant `d` and squared edge-vector lengths
-/// product `edge_product` (from [`angle_extremes`]) is inverted or flat by the
+/// product `edge_product` (from [`cosine_extremes`]) is inverted or flat by the
 /// exact predicate; `corners` gives its points when that must be evaluated.
 ///
 /// The float determinant `a·(b×c)` of the edge vectors from corner 0 is off by
