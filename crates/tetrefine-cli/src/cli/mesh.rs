@@ -15,7 +15,7 @@ pub struct Args {
     /// Largest radius-edge ratio of a tet (TetGen -q; at least 1.0).
     #[arg(long, value_name = "R")]
     pub min_ratio: Option<f64>,
-    /// Smallest dihedral angle in degrees (TetGen -q<R>/<DEG>; R defaults to 2.0).
+    /// Smallest dihedral angle in degrees (TetGen -q R/DEG; R defaults to 2.0).
     #[arg(long, value_name = "DEG")]
     pub min_dihedral: Option<f64>,
     /// Largest tet volume (TetGen -a).
