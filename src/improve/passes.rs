@@ -766,9 +766,10 @@ struct Refusal {
 /// permissions, and every operation that changes the shell of an edge of
 /// the tet either removes the tet (its slot's generation moves on) or
 /// makes or removes a tet holding the edge's ends, which stamps them. So
-/// the result is the one of searching again. Measured on two default steps of mmg_tinyBoxt: 1.9 s
-/// less of 77.6 s, the output byte for byte the same; the last round's ten
-/// passes searched the same few hundred tets again each time.
+/// the result is the one of searching again. Measured on two default
+/// steps of mmg_tinyBoxt: 1.9 s less of 77.6 s, the output byte for byte
+/// the same; the last round's ten passes searched the same few hundred
+/// tets again each time.
 fn insert_pass(
     mesh: &mut TetMesh,
     tr: &mut Tracker,
