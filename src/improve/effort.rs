@@ -84,9 +84,11 @@ impl Effort {
         }
     }
 
-    /// The long-edge factor of a refinement step at this effort
-    /// ([`ImproveOptions::long_edge_factor`]): `None` for `fast`, whose tet
-    /// count is the √3 step's own.
+    /// The long-edge factor of a refinement step at this effort: each of its
+    /// long-edge rounds splits the edges of the step's tets longer than this
+    /// times the mean edge length at their ends, then settles the new balls
+    /// with the passes. `None` for `fast`, whose tet count is the √3 step's
+    /// own.
     pub fn long_edge_factor(self) -> Option<f64> {
         match self {
             Effort::Fast => None,

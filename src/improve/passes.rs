@@ -16,7 +16,6 @@ use super::boundary_smooth::{BoundarySmoothOptions, BoundarySmoothReport, Bounda
 use super::colour::{colour_balls_except, sequential_levels, Balls};
 use super::insertion::{plan_insertion, InsertionScratch};
 use super::laplacian::{laplacian_position_in, BallNow};
-use super::long_edges::split_long_edges;
 use super::optimize::{optimize_position_in, OptimizeParams};
 use super::ring::canonicalize_ring;
 use super::BallPoints;
@@ -77,14 +76,6 @@ pub struct ImproveOptions {
     /// Boundary and interface vertices smoothed inside their patch
     /// ([`BoundarySmoothOptions`]); `None`: the boundary stays fixed.
     pub boundary: Option<BoundarySmoothOptions>,
-    /// Before the passes, split at its midpoint every edge longer than this
-    /// factor times the mean edge length at its ends (a refinement step's
-    /// old edges, which the √3 operations keep); `None`: no split, the tet
-    /// count stays. Refinement sets it ([`Effort::long_edge_factor`](super::Effort::long_edge_factor)).
-    pub long_edge_factor: Option<f64>,
-    /// Per tet slot: may an edge of it be split by the long-edge pass? An
-    /// edge is split only if all its tets may be. `None`: as `tet_allowed`.
-    pub long_edge_zone: Option<Vec<bool>>,
     /// Insert a vertex on an edge of a tet still below `threshold` after
     /// the flips and contractions of a pass, where that raises the worst tet
     /// of the edge's shell (see `insert_pass`); the tet count grows.
@@ -118,8 +109,6 @@ impl Default for ImproveOptions {
             tet_allowed: None,
             smooth_block: 1 << 20,
             boundary: Some(BoundarySmoothOptions::default()),
-            long_edge_factor: None,
-            long_edge_zone: None,
             insert_vertices: true,
             floor: 0.0,
         }
@@ -143,7 +132,8 @@ pub struct ImproveReport {
     pub line_moves: usize,
     /// Boundary sliver caps removed ([`crate::ops::remove_boundary_cap`]).
     pub caps_removed: usize,
-    /// Long edges split at their midpoint ([`ImproveOptions::long_edge_factor`]).
+    /// Long edges split at their midpoint by a refinement step's long-edge
+    /// rounds ([`Effort::long_edge_factor`](super::Effort::long_edge_factor)).
     pub long_edges_split: usize,
     /// Boundary faces those splits cut in two, each adding one boundary
     /// face (two for a boundary edge between two boundary faces).
@@ -376,29 +366,14 @@ impl Tracker {
 /// number of threads.
 pub fn improve(mesh: &mut TetMesh, opts: &ImproveOptions) -> ImproveReport {
     let mut report = ImproveReport::default();
-    let mut tet_allowed = opts.tet_allowed.clone();
-    // Points from long-edge splits lie in the zone, so they may move.
-    let first_new_point = mesh.n_points();
-    if let Some(factor) = opts.long_edge_factor {
-        let mut zone = opts.long_edge_zone.clone().or_else(|| tet_allowed.clone());
-        let split = split_long_edges(mesh, factor, opts.threshold, zone.as_mut());
-        report.long_edges_split = split.edges;
-        report.long_edge_boundary_faces = split.boundary_faces;
-        let new_tets = split.new_tets;
-        if let Some(a) = &mut tet_allowed {
-            a.resize(mesh.n_tet_slots().max(a.len()), false);
-            for t in new_tets {
-                a[t as usize] = true;
-            }
-        }
-    }
+    let tet_allowed = opts.tet_allowed.clone();
     let fixed = mesh.fixed_vertices();
     // The vertices the caller lets change (`--smooth refined`'s zone).
     let mut zone: Vec<bool> = (0..mesh.n_points())
         .map(|v| {
             opts.movable
                 .as_ref()
-                .is_none_or(|m| m.get(v).copied().unwrap_or(v >= first_new_point))
+                .is_none_or(|m| m.get(v).copied().unwrap_or(false))
         })
         .collect();
     let mut movable: Vec<bool> = (0..mesh.n_points()).map(|v| !fixed[v] && zone[v]).collect();

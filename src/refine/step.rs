@@ -1,7 +1,7 @@
 //! The phases of one √3 step (see the module docs of [`crate::refine`](mod@crate::refine)).
 
 use super::{InterfaceRule, NoProgress, Phase, PhaseReport, Progress, RefineOptions, StepReport};
-use crate::improve::{improve, ImproveOptions};
+use crate::improve::{improve, split_long_edges, ImproveOptions};
 use crate::mesh::ball_stays_positive;
 use crate::mesh::fasthash::FastHashMap;
 use crate::mesh::partition::{canonical_centroid, partition_edges, PartitionMarker};
@@ -392,16 +392,25 @@ pub(crate) fn optimize_phase(
     let mut report = improve(mesh, &io);
     if let Some(factor) = opts.effort.long_edge_factor().filter(|_| long_edges) {
         for _ in 0..opts.effort.long_edge_rounds() {
-            // The passes before created and removed tets: the
-            // zone is gathered again.
+            // Only edges of this step's tets: an adaptive step leaves the
+            // rest of the mesh at its size.
+            let mut long_edge_zone = descendants_of_last_step(mesh, step);
+            let split = split_long_edges(mesh, factor, bar, Some(&mut long_edge_zone));
+            // The splits appended their points and tets at the ends of the
+            // arrays, away from their neighbours: brought together again,
+            // the settling passes load balls from fewer cache lines.
+            // Measured on one default step (2026-12-06, quiet machine, one
+            // run each): mmg_tinyBoxt 4.69 s → 4.29 s, tetgen_example
+            // 2.35 s → 2.17 s, a 26³ cube grid 5.85 s → 5.55 s, gmsh_t16
+            // 1.27 s both.
+            mesh.reorder_spatially_in_place();
+            // The zone is gathered after the split, so it holds the new
+            // tets (of this step's level, as the tets they halve) and their
+            // points.
             let (movable, tet_allowed) = smoothing_zone(mesh, step, opts);
             let io = ImproveOptions {
                 movable,
                 tet_allowed,
-                long_edge_factor: Some(factor),
-                // Only edges of this step's tets: an adaptive
-                // step leaves the rest of the mesh at its size.
-                long_edge_zone: Some(descendants_of_last_step(mesh, step)),
                 edge_threshold: io.edge_threshold.max(SETTLE_EDGE_THRESHOLD),
                 // The boundary stays where the first passes left
                 // it, so `--hausd` bounds the whole step's drift
@@ -410,7 +419,9 @@ pub(crate) fn optimize_phase(
                 boundary: None,
                 ..io
             };
-            let settled = improve(mesh, &io);
+            let mut settled = improve(mesh, &io);
+            settled.long_edges_split += split.edges;
+            settled.long_edge_boundary_faces += split.boundary_faces;
             report.add(&settled);
         }
     }
