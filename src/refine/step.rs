@@ -399,10 +399,11 @@ pub(crate) fn optimize_phase(
             // The splits appended their points and tets at the ends of the
             // arrays, away from their neighbours: brought together again,
             // the settling passes load balls from fewer cache lines.
-            // Measured on one default step (2026-12-06, quiet machine, one
-            // run each): mmg_tinyBoxt 4.69 s → 4.29 s, tetgen_example
-            // 2.35 s → 2.17 s, a 26³ cube grid 5.85 s → 5.55 s, gmsh_t16
-            // 1.27 s both.
+            // Measured on one default step (2026-12-06, two pairs of runs
+            // of the builds without and with it, back to back):
+            // mmg_tinyBoxt 4.69 → 4.29 s and 4.81 → 4.17 s, tetgen_example
+            // 2.35 → 2.17 s and 2.45 → 2.26 s, gmsh_t16 1.27 s both and
+            // 1.43 → 1.35 s, a 26³ cube grid 5.85 → 5.55 s.
             mesh.reorder_spatially_in_place();
             // The zone is gathered after the split, so it holds the new
             // tets (of this step's level, as the tets they halve) and their
