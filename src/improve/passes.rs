@@ -368,15 +368,9 @@ impl Tracker {
 
     /// Keeps the dirty flags only on the tets below `bar` that may change
     /// and on the tets and vertices within `rings` rings of them
-    /// ([`TetMesh::grow_zone`]): what is not dirty is not looked at.
+    /// ([`TetMesh::zone_around_tets`]): what is not dirty is not looked at.
     fn focus_below(&mut self, mesh: &TetMesh, bar: f64, rings: usize) {
-        let mut near = vec![false; mesh.n_points()];
-        for t in self.allowed_below(mesh, bar) {
-            for v in mesh.tet(t) {
-                near[v as usize] = true;
-            }
-        }
-        let (verts, tets) = mesh.grow_zone(near, rings, |_| true);
+        let (verts, tets) = mesh.zone_around_tets(&self.allowed_below(mesh, bar), rings);
         for (d, &z) in self.tet_dirty.iter_mut().zip(&tets) {
             *d &= z;
         }
@@ -401,7 +395,6 @@ impl Tracker {
 /// number of threads.
 pub fn improve(mesh: &mut TetMesh, opts: &ImproveOptions) -> ImproveReport {
     let mut report = ImproveReport::default();
-    let tet_allowed = opts.tet_allowed.clone();
     let fixed = mesh.fixed_vertices();
     // The vertices the caller lets change (`--smooth refined`'s zone).
     let mut zone: Vec<bool> = (0..mesh.n_points())
@@ -413,7 +406,7 @@ pub fn improve(mesh: &mut TetMesh, opts: &ImproveOptions) -> ImproveReport {
         .collect();
     let mut movable: Vec<bool> = (0..mesh.n_points()).map(|v| !fixed[v] && zone[v]).collect();
     drop(fixed);
-    let mut tr = Tracker::new(mesh, tet_allowed);
+    let mut tr = Tracker::new(mesh, opts.tet_allowed.clone());
     // A Laplacian move for the mean may lower its ball's worst down to the
     // bar, never below the worst of the mesh as it came in (the floor then
     // rises to that worst): on a mesh already above the bar, `improve`

@@ -737,6 +737,18 @@ impl TetMesh {
         }
     }
 
+    /// The zone of [`Self::grow_zone`] seeded with the vertices of `tets`
+    /// and grown through any tet.
+    pub(crate) fn zone_around_tets(&self, tets: &[u32], rings: usize) -> (Vec<bool>, Vec<bool>) {
+        let mut seeds = vec![false; self.n_points()];
+        for &t in tets {
+            for v in self.tet(t) {
+                seeds[v as usize] = true;
+            }
+        }
+        self.grow_zone(seeds, rings, |_| true)
+    }
+
     /// A zone grown from the vertices `seeds` (per point) by `rings` rings
     /// of tets: each ring takes every live tet `through` admits with a
     /// vertex in the zone, and that tet's vertices. Returns the zone's

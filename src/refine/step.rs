@@ -489,13 +489,7 @@ fn rescue_options(
     }
     // The bad tets' vertices, then every tet and vertex of their balls
     // (grown through any tet; the zone's limits apply after).
-    let mut near = vec![false; mesh.n_points()];
-    for &t in &bad {
-        for v in mesh.tet(t) {
-            near[v as usize] = true;
-        }
-    }
-    let (mut movable, mut tets) = mesh.grow_zone(near, 1, |_| true);
+    let (mut movable, mut tets) = mesh.zone_around_tets(&bad, 1);
     if let Some(m) = &zone_movable {
         movable.iter_mut().zip(m).for_each(|(x, &z)| *x &= z);
     }
