@@ -157,6 +157,24 @@ fn a_default_step_evens_out_edge_lengths() {
     }
 }
 
+/// Issue 14, point 6, where the split at an edge's midpoint would leave a
+/// thin half: mmg_cube's longest edges after a √3 step are chords between
+/// two faces of the cube whose midpoint splits cut a poor tet, and split at
+/// their midpoints only they stayed (the longest 0.72 against the input's
+/// 1.02). Split off the middle where the midpoint is refused, a default
+/// step leaves its longest edge below half the input's (0.33).
+#[test]
+fn a_default_step_halves_mmg_cubes_longest_edge() {
+    let (mut mesh, _) = load_mesh(&crate::support::path("meshes/mmg_cube.mesh")).unwrap();
+    let (input_longest, _) = edge_spread(&mesh);
+    refine_step(&mut mesh, 1, &RefineOptions::default());
+    let (longest, _) = edge_spread(&mesh);
+    assert!(
+        longest < 0.5 * input_longest,
+        "longest {input_longest:.4} -> {longest:.4}"
+    );
+}
+
 /// The longest edge of `mesh`, and the share of its edges longer than 1.4
 /// times the mean length of the edges at their two ends.
 fn edge_spread(mesh: &tetrefine::TetMesh) -> (f64, f64) {
