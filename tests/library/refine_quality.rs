@@ -162,7 +162,7 @@ fn a_default_step_evens_out_edge_lengths() {
 /// two faces of the cube whose midpoint splits cut a poor tet, and split at
 /// their midpoints only they stayed (the longest 0.72 against the input's
 /// 1.02). Split off the middle where the midpoint is refused, a default
-/// step leaves its longest edge below half the input's (0.33).
+/// step leaves its longest edge below half the input's (0.34).
 #[test]
 fn a_default_step_halves_mmg_cubes_longest_edge() {
     let (mut mesh, _) = load_mesh(&crate::support::path("meshes/mmg_cube.mesh")).unwrap();
