@@ -322,26 +322,27 @@ pub(crate) fn split_long_edges(
         // the pieces of every ball as they were, so a ball found whole
         // stays whole.)
         let found = &shells[e.shell];
-        let t = if e.whole_ball
+        // Where along the edge it is split (see `split_point`).
+        let at = if e.whole_ball
             && found
                 .iter()
                 .all(|&(t, g)| mesh.is_alive(t) && mesh.generation(t) == g)
         {
-            let Some(t) = e.at else { continue };
+            let Some(at) = e.at else { continue };
             sh.clear();
             sh.extend(found.iter().map(|&(t, _)| t));
-            t
+            at
         } else {
             mesh.edge_shell(a, b, &mut sh);
             if sh.is_empty() || !sh.iter().all(|&t| in_zone(&zone, t)) {
                 continue;
             }
-            let Some(t) = split_point(mesh, a, b, bar, &sh) else {
+            let Some(at) = split_point(mesh, a, b, bar, &sh) else {
                 continue;
             };
-            t
+            at
         };
-        let p = mesh.point(a).lerp(mesh.point(b), t);
+        let p = mesh.point(a).lerp(mesh.point(b), at);
         let boundary_faces: usize = sh
             .iter()
             .map(|&t| {
