@@ -409,17 +409,7 @@ pub(crate) fn optimize_phase(
             // tets (of this step's level, as the tets they halve) and their
             // points.
             let (movable, tet_allowed) = smoothing_zone(mesh, step, opts);
-            let io = ImproveOptions {
-                movable,
-                tet_allowed,
-                edge_threshold: io.edge_threshold.max(SETTLE_EDGE_THRESHOLD),
-                // The boundary stays where the first passes left
-                // it, so `--hausd` bounds the whole step's drift
-                // (moving it again would measure from the moved
-                // surface); this costs 0.1°–0.2° of average.
-                boundary: None,
-                ..io
-            };
+            let io = settling(&io, movable, tet_allowed);
             let mut settled = improve(mesh, &io);
             settled.long_edges_split += split.edges;
             settled.long_edge_boundary_faces += split.boundary_faces;
@@ -459,6 +449,26 @@ pub(crate) fn optimize_phase(
     report
 }
 
+/// The options of the passes that settle the balls of long-edge splits:
+/// `io`'s over the zone `movable` / `tet_allowed` (as in
+/// [`ImproveOptions`]), with edge removal up to [`SETTLE_EDGE_THRESHOLD`].
+/// The boundary stays where the first passes left it, so `--hausd` bounds
+/// the whole step's drift (moving it again would measure from the moved
+/// surface); this costs 0.1°–0.2° of average.
+fn settling(
+    io: &ImproveOptions,
+    movable: Option<Vec<bool>>,
+    tet_allowed: Option<Vec<bool>>,
+) -> ImproveOptions {
+    ImproveOptions {
+        movable,
+        tet_allowed,
+        edge_threshold: io.edge_threshold.max(SETTLE_EDGE_THRESHOLD),
+        boundary: None,
+        ..io.clone()
+    }
+}
+
 /// The distributed band's long-edge round: the serial step's rounds left
 /// the edges of the cut's faces whole ([`split_long_edges`] refuses an edge
 /// of a partition face, whose other side the rank across holds); once the
@@ -489,13 +499,7 @@ fn band_long_edge_round(
     // is a band tet): they may move.
     verts.resize(mesh.n_points(), true);
     tets.resize(mesh.n_tet_slots(), false);
-    let settle = ImproveOptions {
-        movable: Some(verts.clone()),
-        tet_allowed: Some(tets.clone()),
-        edge_threshold: io.edge_threshold.max(SETTLE_EDGE_THRESHOLD),
-        boundary: None,
-        ..io.clone()
-    };
+    let settle = settling(io, Some(verts.clone()), Some(tets.clone()));
     let mut settled = improve(mesh, &settle);
     settled.long_edges_split += split.edges;
     settled.long_edge_boundary_faces += split.boundary_faces;
