@@ -20,8 +20,10 @@
 //!    three layers of the cut move to the lowest rank holding one of their
 //!    vertices, so the old cut lies inside a part with a free layer before
 //!    the new cut, and the optimize phase runs again over the band the old
-//!    cut froze, with only the new cut frozen. Then ranks above the mean
-//!    share give whole layers to neighbours below it (the rebalance).
+//!    cut froze, with only the new cut frozen, including a long-edge round
+//!    for the old cut's edges that the steps' rounds left whole. Then ranks
+//!    above the mean share give whole layers to neighbours below it (the
+//!    rebalance).
 //! 4. **Census.** After each step the ranks check that the cut conforms
 //!    (every partition face held by exactly two ranks), reduce the
 //!    statistics of the union ([`global_stats`]) and, at the end, number
