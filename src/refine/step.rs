@@ -1,7 +1,7 @@
 //! The phases of one √3 step (see the module docs of [`crate::refine`](mod@crate::refine)).
 
 use super::{InterfaceRule, NoProgress, Phase, PhaseReport, Progress, RefineOptions, StepReport};
-use crate::improve::{improve, split_long_edges, ImproveOptions};
+use crate::improve::{improve, split_long_edges, ImproveOptions, ImproveReport, LongEdgeSplits};
 use crate::mesh::ball_stays_positive;
 use crate::mesh::fasthash::FastHashMap;
 use crate::mesh::partition::{canonical_centroid, partition_edges, PartitionMarker};
@@ -351,9 +351,9 @@ pub(crate) fn optimize_phase(
     long_edges: bool,
     zone: Option<(Vec<bool>, Vec<bool>)>,
     floor: f64,
-) -> crate::improve::ImproveReport {
+) -> ImproveReport {
     if opts.opt_passes == 0 {
-        return crate::improve::ImproveReport::default();
+        return ImproveReport::default();
     }
     // The distributed band's long-edge round and rescue (below) need its
     // points and tets after the passes.
@@ -409,11 +409,7 @@ pub(crate) fn optimize_phase(
             // tets (of this step's level, as the tets they halve) and their
             // points.
             let (movable, tet_allowed) = smoothing_zone(mesh, step, opts);
-            let io = settling(&io, movable, tet_allowed);
-            let mut settled = improve(mesh, &io);
-            settled.long_edges_split += split.edges;
-            settled.long_edge_boundary_faces += split.boundary_faces;
-            report.add(&settled);
+            report.add(&settle_splits(mesh, &split, &io, movable, tet_allowed));
         }
     }
     // The distributed driver's band: the whole mesh around it had every
@@ -449,24 +445,31 @@ pub(crate) fn optimize_phase(
     report
 }
 
-/// The options of the passes that settle the balls of long-edge splits:
-/// `io`'s over the zone `movable` / `tet_allowed` (as in
-/// [`ImproveOptions`]), with edge removal up to [`SETTLE_EDGE_THRESHOLD`].
-/// The boundary stays where the first passes left it, so `--hausd` bounds
-/// the whole step's drift (moving it again would measure from the moved
-/// surface); this costs 0.1°–0.2° of average.
-fn settling(
+/// The passes that settle the balls of the long-edge splits `split`, with
+/// `io`'s options over the zone `movable` / `tet_allowed` (as in
+/// [`ImproveOptions`]) and edge removal up to [`SETTLE_EDGE_THRESHOLD`];
+/// the report counts the splits too. The boundary stays where the first
+/// passes left it, so `--hausd` bounds the whole step's drift (moving it
+/// again would measure from the moved surface); this costs 0.1°–0.2° of
+/// average.
+fn settle_splits(
+    mesh: &mut TetMesh,
+    split: &LongEdgeSplits,
     io: &ImproveOptions,
     movable: Option<Vec<bool>>,
     tet_allowed: Option<Vec<bool>>,
-) -> ImproveOptions {
-    ImproveOptions {
+) -> ImproveReport {
+    let settle = ImproveOptions {
         movable,
         tet_allowed,
         edge_threshold: io.edge_threshold.max(SETTLE_EDGE_THRESHOLD),
         boundary: None,
         ..io.clone()
-    }
+    };
+    let mut settled = improve(mesh, &settle);
+    settled.long_edges_split += split.edges;
+    settled.long_edge_boundary_faces += split.boundary_faces;
+    settled
 }
 
 /// The distributed band's long-edge round: the serial step's rounds left
@@ -490,20 +493,17 @@ fn band_long_edge_round(
     (verts, tets): (&mut Vec<bool>, &mut Vec<bool>),
     factor: f64,
     io: &ImproveOptions,
-) -> crate::improve::ImproveReport {
+) -> ImproveReport {
     let split = split_long_edges(mesh, factor, io.threshold, Some(tets));
     if split.edges == 0 {
-        return crate::improve::ImproveReport::default();
+        return ImproveReport::default();
     }
-    // The new points lie inside the band (every tet of a split edge's shell
-    // is a band tet): they may move.
+    // The points added since the band was gathered (the splits', and any
+    // the band's passes inserted on an edge of a band tet) lie inside the
+    // band: they may move.
     verts.resize(mesh.n_points(), true);
     tets.resize(mesh.n_tet_slots(), false);
-    let settle = settling(io, Some(verts.clone()), Some(tets.clone()));
-    let mut settled = improve(mesh, &settle);
-    settled.long_edges_split += split.edges;
-    settled.long_edge_boundary_faces += split.boundary_faces;
-    settled
+    settle_splits(mesh, &split, io, Some(verts.clone()), Some(tets.clone()))
 }
 
 /// Options for a last, local round where the passes left a tet below the
