@@ -12,7 +12,11 @@
 //! `l > factor · (L(a) + L(b)) / 2`, where `L(v)` is the mean length of the
 //! edges at `v` as the mesh stands before the pass. A graded mesh keeps its
 //! grading (an edge is compared with its neighbours, not with a global
-//! size), and a uniform mesh has no long edge.
+//! size), and a uniform mesh has no long edge. The relative test alone
+//! leaves long edges among long neighbours, such as a graded input's
+//! coarse part; a cap ([`LengthCap`]) also splits every edge longer than
+//! a multiple of the median of the `L(v)`, so the grading a step keeps
+//! stays within that multiple.
 //!
 //! Every edge may be split: a free interior edge, a chord (an interior edge
 //! between two fixed vertices, crossing a thin part of the domain; its
@@ -75,6 +79,17 @@ fn is_splittable(a: u32, b: u32, cut: &HashSet<[u32; 2]>) -> bool {
 
 /// A block's long edges and their shells' (slot, generation) pairs.
 type LongEdgeBlock = (Vec<LongEdge>, Vec<(u32, u32)>);
+
+/// The length above which [`split_long_edges`] splits an edge whatever
+/// its neighbours' lengths.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) enum LengthCap {
+    /// No cap: only the relative test.
+    Off,
+    /// This multiple of the median, over the points of the zone's tets, of
+    /// the mean edge length at a point, as the mesh stands before the pass.
+    MedianTimes(f64),
+}
 
 /// What [`split_long_edges`] did.
 pub(crate) struct LongEdgeSplits {
@@ -151,6 +166,28 @@ fn split_point(mesh: &TetMesh, a: u32, b: u32, bar: f64, sh: &[u32]) -> Option<f
     (q >= need).then_some(t)
 }
 
+/// The median, over the points of the tets in `zone` (per tet slot;
+/// `None`: every tet), of `mean_len` (per point); 0 when there is none.
+fn median_mean_length(mesh: &TetMesh, mean_len: &[f64], zone: Option<&Vec<bool>>) -> f64 {
+    let mut seen = vec![false; mesh.n_points()];
+    for t in mesh.tet_ids() {
+        if zone.is_none_or(|z| z.get(t as usize).copied().unwrap_or(false)) {
+            for v in mesh.tet(t) {
+                seen[v as usize] = true;
+            }
+        }
+    }
+    let mut lengths: Vec<f64> = (0..mesh.n_points())
+        .filter(|&v| seen[v])
+        .map(|v| mean_len[v])
+        .collect();
+    if lengths.is_empty() {
+        return 0.0;
+    }
+    let mid = lengths.len() / 2;
+    *lengths.select_nth_unstable_by(mid, f64::total_cmp).1
+}
+
 /// Worst quality (min sine) of the tets `sh`.
 fn shell_worst(mesh: &TetMesh, sh: &[u32]) -> f64 {
     sh.iter()
@@ -173,8 +210,8 @@ fn halves_worst(mesh: &TetMesh, a: u32, b: u32, p: glam::DVec3, sh: &[u32]) -> f
 
 /// Splits every edge not on a partition face (nor, between two fixed
 /// vertices, at a pinch; see the module doc) longer than `factor` times the
-/// mean edge length at its two ends, longest first, at its midpoint or the
-/// point near it that [`split_point`] finds. An edge is split only when
+/// mean edge length at its two ends or longer than `cap`, longest first, at
+/// its midpoint or the point near it that [`split_point`] finds. An edge is split only when
 /// every tet of its shell is in `zone` (per tet slot; `None`: every tet;
 /// the new tets join it) and when the worst of the new tets is at least the
 /// smaller of the shell's worst and `bar` (min sine), so the pass never
@@ -188,6 +225,7 @@ fn halves_worst(mesh: &TetMesh, a: u32, b: u32, p: glam::DVec3, sh: &[u32]) -> f
 pub(crate) fn split_long_edges(
     mesh: &mut TetMesh,
     factor: f64,
+    cap: LengthCap,
     bar: f64,
     mut zone: Option<&mut Vec<bool>>,
 ) -> LongEdgeSplits {
@@ -238,6 +276,10 @@ pub(crate) fn split_long_edges(
             .collect()
     };
     let mean_len: Vec<f64> = blocks.iter().flat_map(|b| b.0.iter().copied()).collect();
+    let cap = match cap {
+        LengthCap::Off => f64::INFINITY,
+        LengthCap::MedianTimes(k) => k * median_mean_length(mesh, &mean_len, zone.as_deref()),
+    };
     // The long edges, each with its shell as found (slot and generation of
     // each tet) and whether the split would be kept; per block, then in
     // one list.
@@ -259,7 +301,7 @@ pub(crate) fn split_long_edges(
                     let a = k as u32 * BLOCK + i as u32;
                     for &(b, l) in &upper[from..end as usize] {
                         let local = 0.5 * (mean_len[a as usize] + mean_len[b as usize]);
-                        if l > factor * local {
+                        if l > factor * local || l > cap {
                             let both_fixed = fixed[a as usize] && fixed[b as usize];
                             let walked = mesh.edge_shell(a, b, sh);
                             let whole_ball = walked == tets_at.at(a) as usize;
@@ -412,7 +454,7 @@ mod tests {
         // 6 + 1 + 1, over three.
         let exact = 6.0 * 3f64.sqrt() / 4.0 * 8.0 / 3.0;
         assert!((volume(&m) - exact).abs() < 1e-12);
-        let done = split_long_edges(&mut m, 1.4, 0.3, None);
+        let done = split_long_edges(&mut m, 1.4, LengthCap::Off, 0.3, None);
         assert_eq!((done.edges, done.boundary_faces), (1, 0));
         let new = done.new_tets;
         // Every tet of the six-tet shell becomes two.
@@ -424,7 +466,10 @@ mod tests {
         m.check().expect("a valid mesh after the split");
         // Nothing is long any more at 1.4: a half axis, 3, against
         // 1.4·(2.872 + 1.5)/2 ≈ 3.06 (the means at `a` and at the midpoint).
-        assert_eq!(split_long_edges(&mut m, 1.4, 0.3, None).edges, 0);
+        assert_eq!(
+            split_long_edges(&mut m, 1.4, LengthCap::Off, 0.3, None).edges,
+            0
+        );
     }
 
     /// One tet `a = (0,0,0)`, `b = (2,0,0)`, `p = (0.7,1.2,0)`, `q =
@@ -459,7 +504,7 @@ mod tests {
         };
         let mut m = TetMesh::from_data(&data).expect("one tet").0;
         let bar = 43f64.to_radians().sin();
-        let done = split_long_edges(&mut m, 1.1, bar, None);
+        let done = split_long_edges(&mut m, 1.1, LengthCap::Off, bar, None);
         assert_eq!((done.edges, done.boundary_faces), (1, 2));
         m.check().expect("a valid mesh after the split");
         let x = m.point(m.n_points() as u32 - 1);
@@ -478,10 +523,13 @@ mod tests {
         let mut m = bipyramid();
         let mut zone = vec![true; m.n_tet_slots()];
         zone[3] = false;
-        assert_eq!(split_long_edges(&mut m, 1.4, 0.3, Some(&mut zone)).edges, 0);
+        assert_eq!(
+            split_long_edges(&mut m, 1.4, LengthCap::Off, 0.3, Some(&mut zone)).edges,
+            0
+        );
         assert_eq!(m.n_tets(), 18);
         let mut zone = vec![true; m.n_tet_slots()];
-        let done = split_long_edges(&mut m, 1.4, 0.3, Some(&mut zone));
+        let done = split_long_edges(&mut m, 1.4, LengthCap::Off, 0.3, Some(&mut zone));
         assert_eq!(done.edges, 1);
         let new = done.new_tets;
         assert!(new.iter().all(|&t| zone[t as usize]));
@@ -491,8 +539,14 @@ mod tests {
     fn a_higher_factor_splits_nothing() {
         // The axis is 1.85 times its local mean.
         let mut m = bipyramid();
-        assert_eq!(split_long_edges(&mut m, 1.9, 0.3, None).edges, 0);
-        assert_eq!(split_long_edges(&mut m, 1.8, 0.3, None).edges, 1);
+        assert_eq!(
+            split_long_edges(&mut m, 1.9, LengthCap::Off, 0.3, None).edges,
+            0
+        );
+        assert_eq!(
+            split_long_edges(&mut m, 1.8, LengthCap::Off, 0.3, None).edges,
+            1
+        );
     }
 
     /// The bipyramid's points with only its tets `ids` (slots of
@@ -531,7 +585,7 @@ mod tests {
             m.set_face_marker([0, 1, q], Some(5));
         }
         m.set_feature_edge(0, 1, Some(9));
-        let done = split_long_edges(&mut m, 1.4, 0.3, None);
+        let done = split_long_edges(&mut m, 1.4, LengthCap::Off, 0.3, None);
         assert_eq!((done.edges, done.boundary_faces), (1, 2));
         let new = done.new_tets;
         assert_eq!(new.len(), 10, "five shell tets, two halves each");
@@ -556,7 +610,10 @@ mod tests {
         let mut m = notched();
         let cut = crate::mesh::partition::partition_marker(1);
         m.set_face_marker([0, 1, 2], Some(cut));
-        assert_eq!(split_long_edges(&mut m, 1.4, 0.3, None).edges, 0);
+        assert_eq!(
+            split_long_edges(&mut m, 1.4, LengthCap::Off, 0.3, None).edges,
+            0
+        );
         assert_eq!(m.n_tets(), 17);
     }
 
@@ -567,13 +624,57 @@ mod tests {
         let mut m = bipyramid_part(0..6);
         // Means 6/7 + 6/7 at a and b ((6 + 6·√10)/7 ≈ 3.568), so the axis
         // stands 6/3.568 ≈ 1.68 times over them.
-        assert_eq!(split_long_edges(&mut m, 1.7, 0.3, None).edges, 0);
-        assert_eq!(split_long_edges(&mut m, 1.4, 0.3, None).edges, 1);
+        assert_eq!(
+            split_long_edges(&mut m, 1.7, LengthCap::Off, 0.3, None).edges,
+            0
+        );
+        assert_eq!(
+            split_long_edges(&mut m, 1.4, LengthCap::Off, 0.3, None).edges,
+            1
+        );
         assert_eq!(m.n_tets(), 12);
         m.check().expect("a valid mesh after the split");
         assert!(
             !m.fixed_vertices()[m.n_points() - 1],
             "the midpoint is inside"
         );
+    }
+
+    /// `cube_grid(2)`: edges of 0.5 (along the axes), √2/2 (face
+    /// diagonals) and √3/2 (the eight cube diagonals, each inside its cube
+    /// with a shell of six tets). Computed apart with numpy: the median over
+    /// the 27 points of the mean edge length at a point is 0.61945, and no
+    /// edge is more than 1.3936 times the mean of its ends' means, so the
+    /// relative test at 1.4 finds nothing, a cap of 1.4 times the median
+    /// (0.86722) is above √3/2 = 0.86603, and one of 1.3 times (0.80528)
+    /// is below it and above √2/2.
+    #[test]
+    fn the_cap_splits_the_cube_diagonals_the_relative_test_leaves() {
+        let data = crate::mesh::generate::cube_grid(2);
+        let mut m = TetMesh::from_data(&data).expect("a cube grid").0;
+        assert_eq!(
+            split_long_edges(&mut m, 1.4, LengthCap::Off, 0.3, None).edges,
+            0
+        );
+        let above = LengthCap::MedianTimes(1.4);
+        assert_eq!(split_long_edges(&mut m, 1.4, above, 0.3, None).edges, 0);
+        let done = split_long_edges(&mut m, 1.4, LengthCap::MedianTimes(1.3), 0.3, None);
+        assert_eq!((done.edges, done.boundary_faces), (8, 0));
+        // Each cube's six tets become twelve around its centre.
+        assert_eq!(m.n_tets(), 8 * 12);
+        assert_eq!(m.n_points(), 27 + 8);
+        let mut centres: Vec<[f64; 3]> = (27..35).map(|v| m.point(v).to_array()).collect();
+        centres.sort_by(|x, y| x.partial_cmp(y).expect("finite"));
+        let mut expect = Vec::new();
+        for x in [0.25, 0.75] {
+            for y in [0.25, 0.75] {
+                for z in [0.25, 0.75] {
+                    expect.push([x, y, z]);
+                }
+            }
+        }
+        assert_eq!(centres, expect);
+        assert!((volume(&m) - 1.0).abs() < 1e-12);
+        m.check().expect("a valid mesh after the splits");
     }
 }

@@ -16,7 +16,7 @@ pub mod ring;
 
 pub use boundary_smooth::BoundarySmoothOptions;
 pub use effort::Effort;
-pub(crate) use long_edges::{split_long_edges, LongEdgeSplits};
+pub(crate) use long_edges::{split_long_edges, LengthCap, LongEdgeSplits};
 pub use passes::{improve, ImproveOptions, ImproveReport, DEFAULT_THRESHOLD};
 
 use crate::geom::{all_positive, tet_min_sine};
