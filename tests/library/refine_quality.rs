@@ -175,9 +175,34 @@ fn a_default_step_halves_mmg_cubes_longest_edge() {
     );
 }
 
-/// The longest edge of `mesh`, and the share of its edges longer than 1.4
-/// times the mean length of the edges at their two ends.
-fn edge_spread(mesh: &tetrefine::TetMesh) -> (f64, f64) {
+/// Issue 14, point 6, on a graded input: gmsh_t16's shortest edge is 0.02
+/// times its median, and the relative test alone keeps a step's grading,
+/// so a step left 14.5 % of its edges longer than 1.9 times the median,
+/// over the points, of the mean edge length at a point (measured on the
+/// 2026-12-06 outputs, with numpy). The long-edge rounds after the first
+/// also split every edge over 1.9 times that median as it stands before
+/// them: a default step leaves at most 1 % over it (0.49 % on 2026-12-07),
+/// measured here from the output's edge list.
+#[test]
+fn a_default_step_caps_a_graded_inputs_long_edges() {
+    let (mut mesh, _) = load_mesh(&crate::support::path("meshes/gmsh_t16.mesh")).unwrap();
+    refine_step(&mut mesh, 1, &RefineOptions::default());
+    let (_, lengths, means) = edge_lengths(&mesh);
+    let mut means: Vec<f64> = means.into_iter().filter(|m| !m.is_nan()).collect();
+    means.sort_by(f64::total_cmp);
+    let median = means[means.len() / 2];
+    let over = lengths.iter().filter(|&&l| l > 1.9 * median).count();
+    let share = over as f64 / lengths.len() as f64;
+    assert!(
+        share <= 0.01,
+        "{over} of {} edges over 1.9 x {median:.5}",
+        lengths.len()
+    );
+}
+
+/// The edges of `mesh`, their lengths, and per point the mean length of
+/// its edges (NaN at a point without one).
+fn edge_lengths(mesh: &tetrefine::TetMesh) -> (Vec<[u32; 2]>, Vec<f64>, Vec<f64>) {
     let edges = mesh.edges();
     let lengths: Vec<f64> = edges
         .iter()
@@ -191,12 +216,23 @@ fn edge_spread(mesh: &tetrefine::TetMesh) -> (f64, f64) {
             count[v as usize] += 1;
         }
     }
-    let mean = |v: u32| sum[v as usize] / count[v as usize] as f64;
+    let means = sum
+        .iter()
+        .zip(&count)
+        .map(|(&s, &c)| s / c as f64)
+        .collect();
+    (edges, lengths, means)
+}
+
+/// The longest edge of `mesh`, and the share of its edges longer than 1.4
+/// times the mean length of the edges at their two ends.
+fn edge_spread(mesh: &tetrefine::TetMesh) -> (f64, f64) {
+    let (edges, lengths, means) = edge_lengths(mesh);
     let longest = lengths.iter().copied().fold(0.0, f64::max);
     let out = edges
         .iter()
         .zip(&lengths)
-        .filter(|&(&[a, b], &l)| l > 1.4 * 0.5 * (mean(a) + mean(b)))
+        .filter(|&(&[a, b], &l)| l > 1.4 * 0.5 * (means[a as usize] + means[b as usize]))
         .count();
     (longest, out as f64 / edges.len() as f64)
 }
