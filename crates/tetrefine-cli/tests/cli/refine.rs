@@ -127,9 +127,11 @@ fn bad_options_fail_before_any_work() {
 /// the second step (three times as many, the √3 scheme's even-step rule)
 /// instead of kept, and the worst angle stays at least the input's;
 /// `--step-offset 0` starts the count over (the edges kept). The default
-/// effort's long-edge round may split a few long feature edges after the
-/// √3 phases, each adding one segment: trisection gives at least three
-/// times the input's segments, keeping fewer than twice as many.
+/// effort's long-edge rounds split long feature edges after the √3
+/// phases, each split adding one segment: trisection gives at least three
+/// times the input's segments, keeping fewer (2.08 times on 2026-12-07,
+/// since the second round's cap shortened the edges around them: 828 from
+/// 399, against 1,231 continued; below twice before the cap).
 #[test]
 fn refining_a_refined_vtu_continues_its_step_count() {
     let dir = tempfile::tempdir().unwrap();
@@ -174,7 +176,7 @@ fn refining_a_refined_vtu_continues_its_step_count() {
     );
     let (kept, input) = (features(&s0, 1), features(&s0, 0));
     assert!(
-        kept >= input && kept < 2 * input,
+        kept >= input && kept < 3 * input && kept < features(&s2, 1),
         "started over: kept, {kept} from {input}"
     );
     assert!(
