@@ -19,10 +19,10 @@ pub const LONG_EDGE_FACTOR: f64 = 1.4;
 /// at a point ([`LengthCap::MedianTimes`]): the relative test
 /// ([`LONG_EDGE_FACTOR`]) leaves long edges among long neighbours, such as
 /// a graded input's coarse part. Measured on one default step of the seven
-/// shipped meshes (2026-12-07), the 99th-percentile edge length against
-/// MMG3D `-hsiz`'s at the same count (MMG's figure of the last comparison
-/// scaled by the cube root of the counts): 1.19×–1.50× without the cap
-/// (five meshes above issue 14's 1.25×), 1.15×–1.23× with it, for
+/// shipped meshes (2026-12-07, `benches/compare.sh`), the 99th-percentile
+/// edge length against MMG3D `-hsiz`'s at the same count: 1.19×–1.50×
+/// without the cap (five meshes above issue 14's 1.25×), 1.18×–1.25× with
+/// it, for
 /// 0.4 %–17 % more tets and 77 % more on gmsh_t16 (a graded input, a
 /// shortest-to-median edge ratio of 0.02). With the cap in every round,
 /// 2.0 left gmsh_t16 at 1.26× (48 % more tets) and 1.8 took 83 % more.

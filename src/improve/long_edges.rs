@@ -166,12 +166,12 @@ fn split_point(mesh: &TetMesh, a: u32, b: u32, bar: f64, sh: &[u32]) -> Option<f
     (q >= need).then_some(t)
 }
 
-/// The median, over the points of the tets in `zone` (per tet slot;
-/// `None`: every tet), of `mean_len` (per point); 0 when there is none.
-fn median_mean_length(mesh: &TetMesh, mean_len: &[f64], zone: Option<&Vec<bool>>) -> f64 {
+/// The median, over the points of the tets `in_zone` says yes to, of
+/// `mean_len` (per point); 0 when there is none.
+fn median_mean_length(mesh: &TetMesh, mean_len: &[f64], in_zone: impl Fn(u32) -> bool) -> f64 {
     let mut seen = vec![false; mesh.n_points()];
     for t in mesh.tet_ids() {
-        if zone.is_none_or(|z| z.get(t as usize).copied().unwrap_or(false)) {
+        if in_zone(t) {
             for v in mesh.tet(t) {
                 seen[v as usize] = true;
             }
@@ -278,7 +278,7 @@ pub(crate) fn split_long_edges(
     let mean_len: Vec<f64> = blocks.iter().flat_map(|b| b.0.iter().copied()).collect();
     let cap = match cap {
         LengthCap::Off => f64::INFINITY,
-        LengthCap::MedianTimes(k) => k * median_mean_length(mesh, &mean_len, zone.as_deref()),
+        LengthCap::MedianTimes(k) => k * median_mean_length(mesh, &mean_len, |t| in_zone(&zone, t)),
     };
     // The long edges, each with its shell as found (slot and generation of
     // each tet) and whether the split would be kept; per block, then in

@@ -498,9 +498,8 @@ fn settle_splits(
 /// cut has moved they are inside a part, so the band's long edges (`factor`
 /// against their ends' means, or over `cap`, its median measured over the
 /// band) are split (only edges whose whole shell is in the band's tets)
-/// and the passes of a
-/// settling round, `io`'s over the band with its new points and tets, even
-/// out the new balls. `verts` and `tets` (the band, per point and per tet
+/// and the passes of a settling round, `io`'s over the band with its new
+/// points and tets, even out the new balls. `verts` and `tets` (the band, per point and per tet
 /// slot) take in the new points and tets. One round, not the effort's count:
 /// the edges the serial rounds missed are those of the cut's faces, and the
 /// band is around them, though the round splits any band edge that is
