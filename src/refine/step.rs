@@ -381,8 +381,9 @@ pub(crate) fn optimize_phase(
     };
     if band.is_some() {
         // The band had only the first passes, without its interface
-        // vertices: it gets the settling round's edge-removal bar.
-        io.edge_threshold = io.edge_threshold.max(SETTLE_EDGE_THRESHOLD);
+        // vertices: it gets a higher edge-removal bar than the settling
+        // rounds' ([`BAND_EDGE_THRESHOLD`]).
+        io.edge_threshold = io.edge_threshold.max(BAND_EDGE_THRESHOLD);
     }
     keep_domain_for(&mut io, opts.boundary);
     let bar = io.threshold;
@@ -456,13 +457,39 @@ pub(crate) fn optimize_phase(
     }
     // A floor above the cap is aimed at, not kept (a Kuhn grid's 45° is out
     // of a √3 step's reach): a rescue there would take the whole mesh.
-    if floor > 0.0 && floor <= FLOOR_BAR_CAP {
+    let target = rescue_target(floor, opts.effort);
+    if target > 0.0 {
         let (movable, tet_allowed) = smoothing_zone(mesh, step, opts);
-        if let Some(rescue) = rescue_options(mesh, movable, tet_allowed, opts, floor) {
+        if let Some(rescue) = rescue_options(mesh, movable, tet_allowed, opts, target) {
             report.add(&improve(mesh, &rescue));
         }
     }
     report
+}
+
+/// The rescue round ([`rescue_options`]) of a `default` or `best` step also
+/// takes the tets its passes left below this minimum sine (about 17.5°),
+/// not only those below the input's worst: the passes lift almost every
+/// tet to the bar (0.35), and one left far below it is a sliver their
+/// order of moves missed. Measured on MMG's 362k-tet mesh of the tripod,
+/// one default step (2026-12-07): one interior tet of 3,370,320 ended at
+/// 15.33°, the next at 20.49°; the round lifted it to 20.49° for about
+/// 0.8 s of a 25 s run. On the ladder's second step its worst cluster
+/// (14.38°, boundary tets at x = −2) stays where it was.
+const RESCUE_BELOW: f64 = 0.3;
+
+/// The minimum sine the rescue round lifts tets to, for a step whose input's
+/// worst has sine `floor`: that floor up to [`FLOOR_BAR_CAP`] (a floor above
+/// it is aimed at, not kept), and at least [`RESCUE_BELOW`] except for
+/// `fast`, which keeps the boundary where it is (the rescue moves it).
+/// 0 means no rescue.
+fn rescue_target(floor: f64, effort: crate::improve::Effort) -> f64 {
+    let kept = if floor <= FLOOR_BAR_CAP { floor } else { 0.0 };
+    if effort == crate::improve::Effort::Fast {
+        kept
+    } else {
+        kept.max(RESCUE_BELOW)
+    }
 }
 
 /// The passes that settle the balls of the long-edge splits `split`, with
@@ -479,17 +506,27 @@ fn settle_splits(
     movable: Option<Vec<bool>>,
     tet_allowed: Option<Vec<bool>>,
 ) -> ImproveReport {
-    let settle = ImproveOptions {
+    let mut settled = improve(mesh, &settle_options(io, movable, tet_allowed));
+    settled.long_edges_split += split.edges;
+    settled.long_edge_boundary_faces += split.boundary_faces;
+    settled
+}
+
+/// The options of a settling round: `io`'s over the zone `movable` /
+/// `tet_allowed` (as in [`ImproveOptions`]), edge removal up to at least
+/// [`SETTLE_EDGE_THRESHOLD`], the boundary where it is.
+fn settle_options(
+    io: &ImproveOptions,
+    movable: Option<Vec<bool>>,
+    tet_allowed: Option<Vec<bool>>,
+) -> ImproveOptions {
+    ImproveOptions {
         movable,
         tet_allowed,
         edge_threshold: io.edge_threshold.max(SETTLE_EDGE_THRESHOLD),
         boundary: None,
         ..io.clone()
-    };
-    let mut settled = improve(mesh, &settle);
-    settled.long_edges_split += split.edges;
-    settled.long_edge_boundary_faces += split.boundary_faces;
-    settled
+    }
 }
 
 /// The distributed band's long-edge round: the serial step's rounds left
@@ -524,7 +561,16 @@ fn band_long_edge_round(
     // band: they may move.
     verts.resize(mesh.n_points(), true);
     tets.resize(mesh.n_tet_slots(), false);
-    settle_splits(mesh, &split, io, Some(verts.clone()), Some(tets.clone()))
+    let mut report = settle_splits(mesh, &split, io, Some(verts.clone()), Some(tets.clone()));
+    // A second settling round over the band: the serial step's balls had
+    // two. Measured on mmg_cube, one step on two ranks (2026-12-07,
+    // `--boundary linear`): average 46.03° → 46.25° (serial 47.49°), a
+    // third round 46.34°; the tripod 48.59° → 48.65° (48.51°).
+    verts.resize(mesh.n_points(), true);
+    tets.resize(mesh.n_tet_slots(), false);
+    let again = settle_options(io, Some(verts.clone()), Some(tets.clone()));
+    report.add(&improve(mesh, &again));
+    report
 }
 
 /// Options for a last, local round where the passes left a tet below the
@@ -618,10 +664,26 @@ fn worst_dihedral(mesh: &TetMesh) -> f64 {
     }
 }
 
-/// Edge removal bar (min sine) of the passes after the long-edge splits:
-/// 0.7 (44°) instead of 0.5 raises the average minimum dihedral by another
-/// 0.4°–0.7° on the shipped meshes for about a fifth more optimize time.
-const SETTLE_EDGE_THRESHOLD: f64 = 0.7;
+/// Edge removal bar (min sine) of the passes after the long-edge splits.
+/// Against the first passes' 0.5, a higher bar raises the average minimum
+/// dihedral angle at the cost of time: measured on one default step of the
+/// seven shipped meshes (2026-12-07, one run each, against 0.7): 0.6
+/// (36.9°) takes 4 %–25 % less wall time (tetgen_example 2.36 → 1.92 s,
+/// gmsh_t16 1.76 → 1.46 s) for 0.16°–0.31° less average, with the same
+/// 99th-percentile edge within 0.5 %; 0.55 saved 4 %–8 % more but cost
+/// 0.4°–0.8° of average and 4.7° of the ladder's worst. With 0.6 the
+/// average stays above MMG3D's at the same count on all seven (by
+/// 0.2°–2.9°, `benches/compare.sh`), while the time is 2–3 times short of
+/// issue 14's 1/8 of MMG's: the trade goes to time.
+const SETTLE_EDGE_THRESHOLD: f64 = 0.6;
+
+/// Edge removal bar (min sine) of the distributed band's passes after the
+/// cut has moved: the band missed the serial rounds, and it is a small part
+/// of the mesh, so it keeps the settling rounds' earlier bar. Measured on
+/// mmg_cube, one step on two ranks against the serial step (2026-12-07,
+/// `--boundary linear`): with 0.6 here too the average was 45.87° against
+/// 47.49°.
+const BAND_EDGE_THRESHOLD: f64 = 0.7;
 
 /// What the optimize phase may touch: with `--smooth refined` the zone of
 /// [`refined_zone`], otherwise everything (`None`, `None`).
@@ -1176,4 +1238,25 @@ fn stencil_targets(
         targets.push((m, pos.faces[i]));
     }
     targets
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::improve::Effort;
+
+    #[test]
+    fn the_rescue_keeps_the_floor_up_to_its_cap_and_lifts_slivers_below_0_3() {
+        // An input worst below the second target: the rescue lifts to 0.3.
+        assert_eq!(rescue_target(0.1, Effort::Default), 0.3);
+        assert_eq!(rescue_target(0.0, Effort::Best), 0.3);
+        // Between the target and the cap: the input's worst is kept.
+        assert_eq!(rescue_target(0.33, Effort::Default), 0.33);
+        assert_eq!(rescue_target(0.36, Effort::Default), 0.36);
+        // Above the cap the floor is aimed at, not kept; slivers still go.
+        assert_eq!(rescue_target(0.5, Effort::Default), 0.3);
+        // `fast` rescues only below the kept floor.
+        assert_eq!(rescue_target(0.1, Effort::Fast), 0.1);
+        assert_eq!(rescue_target(0.5, Effort::Fast), 0.0);
+    }
 }

@@ -229,7 +229,8 @@ fn pieces_form_one_conforming_mesh_with_exact_region_volumes_on_1_and_2_ranks() 
             // round splits more edges than the band's one round reaches,
             // so mmg_cube, the smallest mesh with the largest share of
             // its tets in the band, gets 1.5° until the band's round
-            // catches up.
+            // catches up (with the settling bar at 0.6 and the band's
+            // second settling round: 46.25° against 47.49°, 1.24°).
             let tolerance = if name.contains("mmg_cube") { 1.5 } else { 1.0 };
             for key in ["worst", "avg"] {
                 let (a, b) = (
