@@ -455,8 +455,6 @@ pub(crate) fn optimize_phase(
         }
         return report;
     }
-    // A floor above the cap is aimed at, not kept (a Kuhn grid's 45° is out
-    // of a √3 step's reach): a rescue there would take the whole mesh.
     let target = rescue_target(floor, opts.effort);
     if target > 0.0 {
         let (movable, tet_allowed) = smoothing_zone(mesh, step, opts);
@@ -480,9 +478,10 @@ const RESCUE_BELOW: f64 = 0.3;
 
 /// The minimum sine the rescue round lifts tets to, for a step whose input's
 /// worst has sine `floor`: that floor up to [`FLOOR_BAR_CAP`] (a floor above
-/// it is aimed at, not kept), and at least [`RESCUE_BELOW`] except for
-/// `fast`, which keeps the boundary where it is (the rescue moves it).
-/// 0 means no rescue.
+/// it is aimed at, not kept: a Kuhn grid's 45° is out of a √3 step's reach,
+/// and a rescue there would take the whole mesh), and at least
+/// [`RESCUE_BELOW`] except for `fast`, which keeps the boundary where it is
+/// (the rescue moves it). 0 means no rescue.
 fn rescue_target(floor: f64, effort: crate::improve::Effort) -> f64 {
     let kept = if floor <= FLOOR_BAR_CAP { floor } else { 0.0 };
     if effort == crate::improve::Effort::Fast {
@@ -535,17 +534,18 @@ fn settle_options(
 /// cut has moved they are inside a part, so the band's long edges (`factor`
 /// against their ends' means, or over `cap`, its median measured over the
 /// band) are split (only edges whose whole shell is in the band's tets)
-/// and the passes of a settling round, `io`'s over the band with its new
-/// points and tets, even out the new balls. `verts` and `tets` (the band, per point and per tet
-/// slot) take in the new points and tets. One round, not the effort's count:
-/// the edges the serial rounds missed are those of the cut's faces, and the
-/// band is around them, though the round splits any band edge that is
-/// long against the means at its ends then. Measured on one step on two
-/// ranks (2026-12-07, `--boundary linear`), average minimum dihedral angle
-/// without the round → with it (the serial step's): mmg_cube 45.80° →
-/// 46.30° (47.23°), the tripod 48.37° → 48.53° (48.59°), gmsh_t16 49.96° →
-/// 50.10° (50.18°); the worst unchanged; tets 5,486 → 6,010 (6,027),
-/// 33,446 → 34,320 (33,783), 147,205 → 151,592 (147,056).
+/// and [`BAND_SETTLING_ROUNDS`] settling rounds, `io`'s passes over the
+/// band with its new points and tets, even out the new balls. `verts` and
+/// `tets` (the band, per point and per tet slot) take in the new points
+/// and tets. One split round, not the effort's count: the edges the serial
+/// rounds missed are those of the cut's faces, and the band is around
+/// them, though the round splits any band edge that is long against the
+/// means at its ends then. Measured on one step on two ranks (2026-12-07,
+/// `--boundary linear`, one settling round), average minimum dihedral
+/// angle without the round → with it (the serial step's): mmg_cube 45.80°
+/// → 46.30° (47.23°), the tripod 48.37° → 48.53° (48.59°), gmsh_t16
+/// 49.96° → 50.10° (50.18°); the worst unchanged; tets 5,486 → 6,010
+/// (6,027), 33,446 → 34,320 (33,783), 147,205 → 151,592 (147,056).
 fn band_long_edge_round(
     mesh: &mut TetMesh,
     (verts, tets): (&mut Vec<bool>, &mut Vec<bool>),
@@ -556,22 +556,29 @@ fn band_long_edge_round(
     if split.edges == 0 {
         return ImproveReport::default();
     }
-    // The points added since the band was gathered (the splits', and any
-    // the band's passes inserted on an edge of a band tet) lie inside the
-    // band: they may move.
-    verts.resize(mesh.n_points(), true);
-    tets.resize(mesh.n_tet_slots(), false);
-    let mut report = settle_splits(mesh, &split, io, Some(verts.clone()), Some(tets.clone()));
-    // A second settling round over the band: the serial step's balls had
-    // two. Measured on mmg_cube, one step on two ranks (2026-12-07,
-    // `--boundary linear`): average 46.03° → 46.25° (serial 47.49°), a
-    // third round 46.34°; the tripod 48.59° → 48.65° (48.51°).
-    verts.resize(mesh.n_points(), true);
-    tets.resize(mesh.n_tet_slots(), false);
-    let again = settle_options(io, Some(verts.clone()), Some(tets.clone()));
-    report.add(&improve(mesh, &again));
+    let mut report = ImproveReport {
+        long_edges_split: split.edges,
+        long_edge_boundary_faces: split.boundary_faces,
+        ..Default::default()
+    };
+    for _ in 0..BAND_SETTLING_ROUNDS {
+        // The points added since the band was gathered (the splits', and
+        // any the passes inserted on an edge of a band tet) lie inside the
+        // band: they may move.
+        verts.resize(mesh.n_points(), true);
+        tets.resize(mesh.n_tet_slots(), false);
+        let settle = settle_options(io, Some(verts.clone()), Some(tets.clone()));
+        report.add(&improve(mesh, &settle));
+    }
     report
 }
+
+/// Settling rounds after the band's long-edge splits: two, as the serial
+/// step's balls had two rounds. Measured on mmg_cube, one step on two ranks
+/// (2026-12-07, `--boundary linear`): average 46.03° with one, 46.25° with
+/// two, 46.34° with three (serial 47.49°); the tripod 48.59° → 48.65°
+/// (48.51°).
+const BAND_SETTLING_ROUNDS: usize = 2;
 
 /// Options for a last, local round where the passes left a tet below the
 /// input's worst (`floor`): the `best` effort's options (a higher bar, larger
