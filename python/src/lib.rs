@@ -689,7 +689,9 @@ impl Mesh {
     ///   effort        'fast' (boundary fixed, no long-edge splits),
     ///                 'default' (boundary vertices move inside their patch
     ///                 and along feature lines, sliver caps removed, two
-    ///                 rounds of long-edge splits) or 'best' [--effort].
+    ///                 rounds of long-edge splits and, from the second step
+    ///                 on, a third for the edges that still stand out) or
+    ///                 'best' [--effort].
     ///   hausd         Hausdorff bound of boundary moves (MMG's -hausd);
     ///                 None: 5 % of the local edge length (15 % of a
     ///                 sliver cap's mean edge for its removal) [--hausd].

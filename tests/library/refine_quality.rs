@@ -6,7 +6,7 @@ use std::path::Path;
 use tetrefine::io::load_mesh;
 use tetrefine::MeshStats;
 use tetrefine::{improve, ImproveOptions};
-use tetrefine::{refine_step, RefineOptions, Sqrt3Rule};
+use tetrefine::{refine, refine_step, RefineOptions, Sqrt3Rule};
 
 #[test]
 fn tripod_beats_table_1_in_every_boundary_mode() {
@@ -157,6 +157,28 @@ fn a_default_step_evens_out_edge_lengths() {
     }
 }
 
+/// Issue 14, point 6, the tail after two steps: a step keeps the tail of
+/// edges the step before left, and its long-edge rounds' settling passes
+/// and splits add to it; the outlier round of a second step splits the
+/// edges over 1.5 times the means at their ends. The share of edges over
+/// 1.5 times the mean length of the edges at their two ends after two
+/// default steps (2026-12-07): here (no features detected) 0.12 %
+/// (tripod), 0.14 % (holed bar) and 0.21 % (mmg_cube), and 0.27 % on the
+/// tripod with the round switched off; measured with numpy on the CLI's
+/// outputs (features detected), 0.30 %, 0.36 % and 0.36 % without the
+/// round, 0.15 %, 0.18 % and 0.21 % with it. At most 0.25 % is allowed.
+#[test]
+fn two_default_steps_trim_the_tail_of_long_edges() {
+    for name in ["tripod", "getfem_holed_bar", "mmg_cube"] {
+        let (mut mesh, _) =
+            load_mesh(&crate::support::path(&format!("meshes/{name}.mesh"))).unwrap();
+        refine(&mut mesh, 2, &RefineOptions::default());
+        let (_, standing_out) = edge_spread_over(&mesh, 1.5);
+        eprintln!("{name}: {standing_out:.5} of the edges stand out");
+        assert!(standing_out <= 0.0025, "{name}: {standing_out}");
+    }
+}
+
 /// Issue 14, point 6, where the split at an edge's midpoint would leave a
 /// thin half: mmg_cube's longest edges after a √3 step are chords between
 /// two faces of the cube whose midpoint splits cut a poor tet, and split at
@@ -227,12 +249,18 @@ fn edge_lengths(mesh: &tetrefine::TetMesh) -> (Vec<[u32; 2]>, Vec<f64>, Vec<f64>
 /// The longest edge of `mesh`, and the share of its edges longer than 1.4
 /// times the mean length of the edges at their two ends.
 fn edge_spread(mesh: &tetrefine::TetMesh) -> (f64, f64) {
+    edge_spread_over(mesh, 1.4)
+}
+
+/// The longest edge of `mesh` and the share of its edges longer than
+/// `factor` times the mean length of the edges at their two ends.
+fn edge_spread_over(mesh: &tetrefine::TetMesh, factor: f64) -> (f64, f64) {
     let (edges, lengths, means) = edge_lengths(mesh);
     let longest = lengths.iter().copied().fold(0.0, f64::max);
     let out = edges
         .iter()
         .zip(&lengths)
-        .filter(|&(&[a, b], &l)| l > 1.4 * 0.5 * (means[a as usize] + means[b as usize]))
+        .filter(|&(&[a, b], &l)| l > factor * 0.5 * (means[a as usize] + means[b as usize]))
         .count();
     (longest, out as f64 / edges.len() as f64)
 }

@@ -68,8 +68,10 @@ pub struct Args {
     pub threshold: f64,
     /// How hard the optimize phase works: fast (boundary fixed, no long-edge
     /// splits), default (boundary vertices move inside their patch and along
-    /// feature lines; two rounds split long edges), best (more passes, larger
-    /// edge-removal rings, a higher bar, three long-edge rounds).
+    /// feature lines; two rounds split long edges, and from the second step
+    /// on a third the edges that still stand out), best (more passes,
+    /// larger edge-removal rings, a higher bar, three long-edge rounds
+    /// before that third).
     #[arg(long, default_value = "default")]
     pub effort: tetrefine::Effort,
     /// Hausdorff bound (MMG's -hausd): how far boundary moves may take the
