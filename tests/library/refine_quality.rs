@@ -167,6 +167,16 @@ fn a_default_step_evens_out_edge_lengths() {
 /// tripod with the round switched off; measured with numpy on the CLI's
 /// outputs (features detected), 0.30 %, 0.36 % and 0.36 % without the
 /// round, 0.15 %, 0.18 % and 0.21 % with it. At most 0.25 % is allowed.
+///
+/// The longest edge, too: where no point of a very long free interior
+/// edge cuts its shell above the bar, the edge is split at a lower bar
+/// and the settling passes lift its halves. Here (no features detected)
+/// the longest edge after two steps is 1.40 (tripod), 1.43 (holed bar)
+/// and 1.42 (mmg_cube) times the 99th percentile of the edge lengths,
+/// and mmg_cube's was 1.74 without the lower bar; on the CLI's outputs
+/// (features detected) it was 1.94, 1.72 and 1.74 without it, 1.35, 1.31
+/// and 1.42 with it, and MMG3D `-hsiz`'s outputs at the same counts have
+/// 1.34, 1.27 and 1.25. At most 1.5 is allowed.
 #[test]
 fn two_default_steps_trim_the_tail_of_long_edges() {
     for name in ["tripod", "getfem_holed_bar", "mmg_cube"] {
@@ -174,8 +184,12 @@ fn two_default_steps_trim_the_tail_of_long_edges() {
             load_mesh(&crate::support::path(&format!("meshes/{name}.mesh"))).unwrap();
         refine(&mut mesh, 2, &RefineOptions::default());
         let (_, standing_out) = edge_spread_over(&mesh, 1.5);
-        eprintln!("{name}: {standing_out:.5} of the edges stand out");
+        let longest = longest_over_percentile_99(&mesh);
+        eprintln!(
+            "{name}: {standing_out:.5} of the edges stand out, the longest {longest:.3} x the 99th percentile"
+        );
         assert!(standing_out <= 0.0025, "{name}: {standing_out}");
+        assert!(longest <= 1.5, "{name}: {longest}");
     }
 }
 
@@ -184,7 +198,10 @@ fn two_default_steps_trim_the_tail_of_long_edges() {
 /// two faces of the cube whose midpoint splits cut a poor tet, and split at
 /// their midpoints only they stayed (the longest 0.72 against the input's
 /// 1.02). Split off the middle where the midpoint is refused, a default
-/// step leaves its longest edge below half the input's (0.34).
+/// step leaves its longest edge below half the input's (0.34); split at a
+/// lower bar where the edge is very long and free, within 1.4 times the
+/// 99th percentile of the edge lengths (1.59 times without; MMG3D
+/// `-hsiz`'s output at the same count has 1.26).
 #[test]
 fn a_default_step_halves_mmg_cubes_longest_edge() {
     let (mut mesh, _) = load_mesh(&crate::support::path("meshes/mmg_cube.mesh")).unwrap();
@@ -194,6 +211,12 @@ fn a_default_step_halves_mmg_cubes_longest_edge() {
     assert!(
         longest < 0.5 * input_longest,
         "longest {input_longest:.4} -> {longest:.4}"
+    );
+    let over = longest_over_percentile_99(&mesh);
+    eprintln!("the longest edge is {over:.3} x the 99th percentile");
+    assert!(
+        over <= 1.4,
+        "the longest edge is {over:.3} x the 99th percentile"
     );
 }
 
@@ -244,6 +267,15 @@ fn edge_lengths(mesh: &tetrefine::TetMesh) -> (Vec<[u32; 2]>, Vec<f64>, Vec<f64>
         .map(|(&s, &c)| s / c as f64)
         .collect();
     (edges, lengths, means)
+}
+
+/// The longest edge of `mesh` over the 99th percentile of its edge
+/// lengths (the length below which 99 % of the edges are).
+fn longest_over_percentile_99(mesh: &tetrefine::TetMesh) -> f64 {
+    let (_, mut lengths, _) = edge_lengths(mesh);
+    lengths.sort_by(f64::total_cmp);
+    let p99 = lengths[(0.99 * (lengths.len() - 1) as f64).round() as usize];
+    lengths[lengths.len() - 1] / p99
 }
 
 /// The longest edge of `mesh`, and the share of its edges longer than 1.4
