@@ -293,6 +293,11 @@ pub(crate) fn split_long_edges(
     let fixed = mesh.fixed_vertices();
     let tets_at = TetsAtVertex::new(mesh);
     let cut = partition_edges(mesh);
+    // Not on a distributed rank's part: the passes there leave the cut's
+    // vertices where they are, and the halves near it stayed thin (mmg_cube
+    // on two ranks: 8,662 tets at 45.29° average against the serial
+    // step's 7,193 at 47.88°).
+    let relax = relax && cut.is_empty();
     // One ball walk per vertex: its mean edge length, and its neighbours of
     // higher id with the edge's length (each edge once, at its lower end),
     // by blocks of vertices so that the lists stay in a few flat arrays.

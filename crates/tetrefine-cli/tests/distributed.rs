@@ -230,8 +230,12 @@ fn pieces_form_one_conforming_mesh_with_exact_region_volumes_on_1_and_2_ranks() 
             // so mmg_cube, the smallest mesh with the largest share of
             // its tets in the band, gets 1.5° until the band's round
             // catches up (with the settling bar at 0.6 and the band's
-            // second settling round: 46.25° against 47.49°, 1.24°).
-            let tolerance = if name.contains("mmg_cube") { 1.5 } else { 1.0 };
+            // second settling round: 46.25° against 47.49°, 1.24°). The
+            // serial step's very long edges split at a lower bar (not on a
+            // rank's part, whose cut vertices stay) raised the serial
+            // average to 47.88° with the two ranks' output the same as
+            // before (7,437 tets, 46.25°): 1.63°, so 1.7 (2026-12-07).
+            let tolerance = if name.contains("mmg_cube") { 1.7 } else { 1.0 };
             for key in ["worst", "avg"] {
                 let (a, b) = (
                     d["min_dihedral_deg"][key].as_f64().unwrap(),
