@@ -141,8 +141,9 @@ const VERY_LONG: f64 = 1.8;
 /// meshes (2026-12-07, `benches/compare.sh`, against MMG3D `-hsiz`'s
 /// longest edge at the same count, before → after): one default step,
 /// mmg_tinyBoxt 1.73× → 1.43× and mmg_cube 1.49× → 1.19×, gmsh_t16's
-/// output 30 tets more, the other four unchanged; two steps, the tripod 1.72× → 1.20×, the holed bar 1.62× →
-/// 1.18×, mmg_cube 1.67× → 1.40×, gmsh_t16 2.51× → 1.48×; worst angles
+/// output 30 tets more, the other four unchanged; two steps, the tripod
+/// 1.72× → 1.20×, the holed bar 1.62× → 1.18×, mmg_cube 1.67× → 1.40×,
+/// gmsh_t16 2.51× → 1.48×; worst angles
 /// within 0.4°, averages within 0.1°. 0.8 left the tripod's two-step
 /// longest at 1.60× (scaled to our count).
 const RELAXED_NEED: f64 = 0.6;
@@ -341,6 +342,12 @@ pub(crate) fn split_long_edges(
         LengthCap::Off => f64::INFINITY,
         LengthCap::MedianTimes(k) => k * median_mean_length(mesh, &mean_len, |t| in_zone(&zone, t)),
     };
+    // Whether the edge `(a, b)` of length `l` is split at the lower bar
+    // ([`VERY_LONG`]).
+    let very_long = |a: u32, b: u32, l: f64| {
+        let local = 0.5 * (mean_len[a as usize] + mean_len[b as usize]);
+        relax && (l > VERY_LONG * local || l > cap)
+    };
     // The long edges, each with its shell as found (slot and generation of
     // each tet) and whether the split would be kept; per block, then in
     // one list.
@@ -377,14 +384,7 @@ pub(crate) fn split_long_edges(
                                     a,
                                     b,
                                     whole_ball,
-                                    at: split_point(
-                                        mesh,
-                                        a,
-                                        b,
-                                        bar,
-                                        sh,
-                                        relax && (l > VERY_LONG * local || l > cap),
-                                    ),
+                                    at: split_point(mesh, a, b, bar, sh, very_long(a, b, l)),
                                     shell: start..shells.len(),
                                 });
                             }
@@ -447,9 +447,7 @@ pub(crate) fn split_long_edges(
             if sh.is_empty() || !sh.iter().all(|&t| in_zone(&zone, t)) {
                 continue;
             }
-            let local = 0.5 * (mean_len[a as usize] + mean_len[b as usize]);
-            let very_long = relax && (e.length > VERY_LONG * local || e.length > cap);
-            let Some(at) = split_point(mesh, a, b, bar, &sh, very_long) else {
+            let Some(at) = split_point(mesh, a, b, bar, &sh, very_long(a, b, e.length)) else {
                 continue;
             };
             at

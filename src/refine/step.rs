@@ -445,18 +445,11 @@ pub(crate) fn optimize_phase(
                 (verts, tets),
                 (factor, cap),
                 &io,
-                false,
             ));
         }
         // The serial steps' outlier round, over the band.
         if let Some(outliers) = opts.effort.outlier_split().filter(|_| step >= 2) {
-            report.add(&band_long_edge_round(
-                mesh,
-                (verts, tets),
-                outliers,
-                &io,
-                false,
-            ));
+            report.add(&band_long_edge_round(mesh, (verts, tets), outliers, &io));
         }
     }
     if let Some((mut verts, _)) = band {
@@ -577,10 +570,8 @@ fn outlier_round(
     // Only edges whose whole shell is at or above the bar: the keep test of
     // `split_long_edges` (the smaller of the shell's worst and the bar)
     // then asks every new tet to be above the bar, so a round for sizes
-    // makes no tet worse than the passes' bar (but the halves of a very
-    // long free interior edge, which its settling passes lift), and the
-    // step's worst tets are left to the rounds and passes before. (On the
-    // shipped meshes'
+    // makes no tet worse than the passes' bar, and the step's worst tets
+    // are left to the rounds and passes before. (On the shipped meshes'
     // second steps no outlier's shell was below the bar: the same outputs
     // with and without this filter.)
     let mut zone = descendants_of_last_step(mesh, step);
@@ -635,11 +626,10 @@ const OUTLIER_SETTLE_PASSES: usize = 2;
 /// against their ends' means, or over `cap`, its median measured over the
 /// band) are split (only edges whose whole shell is in the band's tets)
 /// and [`BAND_SETTLING_ROUNDS`] settling rounds, `io`'s passes over the
-/// band with its new points and tets, even out the new balls; `relax`:
-/// very long free edges are split at the lower bar, as in the serial
-/// rounds. (Off in both band rounds: in the first, on mmg_cube over two
-/// ranks, it took the band to 10,391 tets at 43.52° average against the
-/// serial step's 7,193 at 47.88°.) `verts` and
+/// band with its new points and tets, even out the new balls; no very
+/// long edge is split at the lower bar here (on mmg_cube over two ranks
+/// that took the band to 10,391 tets at 43.52° average against the serial
+/// step's 7,193 at 47.88°). `verts` and
 /// `tets` (the band, per point and per tet slot) take in the new points
 /// and tets. One split round, not the effort's count: the edges the serial
 /// rounds missed are those of the cut's faces, and the band is around
@@ -655,9 +645,8 @@ fn band_long_edge_round(
     (verts, tets): (&mut Vec<bool>, &mut Vec<bool>),
     (factor, cap): (f64, LengthCap),
     io: &ImproveOptions,
-    relax: bool,
 ) -> ImproveReport {
-    let split = split_long_edges(mesh, factor, cap, io.threshold, Some(tets), relax);
+    let split = split_long_edges(mesh, factor, cap, io.threshold, Some(tets), false);
     if split.edges == 0 {
         return ImproveReport::default();
     }
