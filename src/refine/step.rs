@@ -594,14 +594,12 @@ fn outlier_round(
     if split.edges == 0 {
         return ImproveReport::default();
     }
-    let (mut movable, mut tets) = mesh.zone_around_tets(&split.new_tets, OUTLIER_SETTLE_RINGS);
-    let (zone_movable, zone_tets) = smoothing_zone(mesh, step, opts);
-    if let Some(z) = zone_movable {
-        movable.iter_mut().zip(z).for_each(|(m, z)| *m &= z);
-    }
-    if let Some(z) = zone_tets {
-        tets.iter_mut().zip(z).for_each(|(t, z)| *t &= z);
-    }
+    let (movable, tets) = zone_near(
+        mesh,
+        &split.new_tets,
+        OUTLIER_SETTLE_RINGS,
+        smoothing_zone(mesh, step, opts),
+    );
     let io = ImproveOptions {
         passes: OUTLIER_SETTLE_PASSES,
         ..io.clone()
@@ -707,15 +705,8 @@ fn rescue_options(
     if bad.is_empty() {
         return None;
     }
-    // The bad tets' vertices, then every tet and vertex of their balls
-    // (grown through any tet; the zone's limits apply after).
-    let (mut movable, mut tets) = mesh.zone_around_tets(&bad, 1);
-    if let Some(m) = &zone_movable {
-        movable.iter_mut().zip(m).for_each(|(x, &z)| *x &= z);
-    }
-    for t in mesh.tet_ids() {
-        tets[t as usize] &= allowed(t);
-    }
+    // The bad tets' vertices, then every tet and vertex of their balls.
+    let (movable, tets) = zone_near(mesh, &bad, 1, (zone_movable, zone_tets));
     let mut rescue = ImproveOptions {
         movable: Some(movable),
         tet_allowed: Some(tets),
@@ -728,6 +719,26 @@ fn rescue_options(
     };
     keep_domain_for(&mut rescue, opts.boundary);
     Some(rescue)
+}
+
+/// The vertices (per point) and tets (per tet slot) within `rings` rings
+/// of `tets` ([`TetMesh::zone_around_tets`], grown through any tet), then
+/// limited to the zone `--smooth` allows (`zone`: per point, may it move;
+/// per tet slot, may it change; `None`: no limit).
+fn zone_near(
+    mesh: &TetMesh,
+    tets: &[u32],
+    rings: usize,
+    zone: (Option<Vec<bool>>, Option<Vec<bool>>),
+) -> (Vec<bool>, Vec<bool>) {
+    let (mut verts, mut near) = mesh.zone_around_tets(tets, rings);
+    if let Some(z) = zone.0 {
+        verts.iter_mut().zip(z).for_each(|(v, z)| *v &= z);
+    }
+    if let Some(z) = zone.1 {
+        near.iter_mut().zip(z).for_each(|(t, z)| *t &= z);
+    }
+    (verts, near)
 }
 
 /// The linear rule promises the input's domain: a boundary vertex moves
