@@ -200,23 +200,21 @@ fn split_point(
     (q >= need).then_some(t)
 }
 
-/// Whether `(a, b)` (shell `sh`) is an interior edge of one region with no
-/// boundary or marked face at it: its new point would be free.
+/// Whether `(a, b)` (shell `sh`) is neither a feature edge nor an edge of
+/// a constrained face ([`TetMesh::face_is_constrained`]: the boundary, a
+/// region interface, a marked face): its new point would be free.
 fn is_free_interior_edge(mesh: &TetMesh, a: u32, b: u32, sh: &[u32]) -> bool {
-    if mesh.is_feature_edge(a, b) {
-        return false;
-    }
-    let region = mesh.region(sh[0]);
-    sh.iter().all(|&t| {
-        let v = mesh.tet(t);
-        mesh.region(t) == region
-            && (0..4).all(|f| {
+    !mesh.is_feature_edge(a, b)
+        && sh.iter().all(|&t| {
+            let v = mesh.tet(t);
+            // The faces of `t` at the edge: those opposite its other two
+            // corners.
+            (0..4).all(|f| {
                 v[f] == a
                     || v[f] == b
-                    || (!mesh.is_boundary_face(t, f)
-                        && mesh.face_marker(mesh.face_vertices(t, f)).is_none())
+                    || !(mesh.is_boundary_face(t, f) || mesh.is_interface_face(t, f))
             })
-    })
+        })
 }
 
 /// The median, over the points of the tets `in_zone` says yes to, of
