@@ -45,6 +45,8 @@
 //! tripod from 5.70 to 5.14, of the holed bar from 1.33 to 1.13 and of
 //! mmg_tinyBoxt (a feature edge) from 0.275 to 0.241.
 
+use super::optimize::{optimize_position_in, OptimizeParams};
+use super::BallPoints;
 use crate::geom::tet_min_sine;
 use crate::mesh::partition::partition_edges;
 use crate::mesh::TetMesh;
@@ -52,6 +54,7 @@ use crate::ops::edge_split::split_halves;
 use crate::ops::edge_split::split_shell;
 use crate::ops::TetsAtVertex;
 use crate::topo::edge_key;
+use glam::DVec3;
 use rayon::prelude::*;
 use std::collections::HashSet;
 
@@ -111,8 +114,8 @@ struct LongEdge {
     /// Whether the walk that found its shell reached every tet at `a`
     /// (see the loop in [`split_long_edges`]).
     whole_ball: bool,
-    /// Where its split would be kept ([`split_point`]).
-    at: Option<f64>,
+    /// Where its split would put the new point ([`split_point`]).
+    at: Option<DVec3>,
     /// Its shell as found: a range of the list of (slot, generation).
     shell: std::ops::Range<usize>,
 }
@@ -123,6 +126,13 @@ struct LongEdge {
 const SPLIT_STEP: f64 = 0.025;
 /// See [`SPLIT_STEP`].
 const SPLIT_REACH: f64 = 0.2;
+/// How far from the middle the split of an edge whose new point must stay
+/// on it (a feature edge, an edge at a crease) is looked for when no point
+/// within [`SPLIT_REACH`] passes ([`split_point`]). Searching this far for
+/// every edge, out to 0.3 (instead of as a fallback), made mmg_tinyBoxt's one-step
+/// longest edge longer, 0.1231 → 0.1385 (2026-12-07): the best point of the
+/// wider range leaves thinner halves than a nearer point that passes.
+const FAR_REACH: f64 = 0.35;
 
 /// An edge longer than this times the mean edge length at its ends (or
 /// than the cap, [`LengthCap`]) is very long: where it is a free interior
@@ -148,12 +158,24 @@ const VERY_LONG: f64 = 1.8;
 /// longest at 1.60× (scaled to our count).
 const RELAXED_NEED: f64 = 0.6;
 
-/// Where the split of `(a, b)` (shell `sh`) is kept, as the parameter `t`
-/// of the point `(1 - t) a + t b`: the midpoint where its worst new tet is
-/// at least the smaller of the shell's worst and `bar`; else, of the points
-/// of [`SPLIT_STEP`], the one whose worst new tet is best, if it passes the
-/// same test (with a lower bar, [`RELAXED_NEED`], where the edge is
-/// `very_long` and free inside the domain); else `None`.
+/// Where the split of `(a, b)` (shell `sh`) puts its new point: the
+/// midpoint where its worst new tet is at least the smaller of the shell's
+/// worst and `bar`; else, of the points of the edge [`SPLIT_STEP`] apart
+/// within [`SPLIT_REACH`] of the middle, the one whose worst new tet is
+/// best, if it passes the same test; else, where no point of the edge
+/// passes, a point found by what the edge allows:
+///
+/// - a free interior edge (its new point is free) that is `very_long`: the
+///   best point off the edge ([`off_edge_point`]), or the best point of the
+///   edge if that is better, kept at a lower bar ([`RELAXED_NEED`]); a
+///   free interior edge that is not very long is left whole;
+/// - a surface edge between two faces of one plane: the best point of that
+///   plane ([`in_plane_point`]);
+/// - any other edge (a feature edge, an edge at a crease or an interface),
+///   and a flat surface edge whose plane has no point that passes: the
+///   best point of the edge out to [`FAR_REACH`] from the middle.
+///
+/// `None` where none passes.
 ///
 /// The midpoint's split can be refused where a ring vertex lies well to one
 /// side of the plane through the midpoint square to the edge: one half of
@@ -169,6 +191,20 @@ const RELAXED_NEED: f64 = 0.6;
 /// step started from such tets ended lower (two default steps, 2026-12-06:
 /// the holed bar 19.98° and gmsh_t16 18.86°, against 20.72° and 20.54° with
 /// midpoints only).
+///
+/// Where no point of the edge passes, the edge's ring lies near one end
+/// (an edge from a box's corner into its ball, a surface edge from a
+/// feature line across a face): every point of the edge cuts a thin half.
+/// The three fallbacks were measured on two default steps of mmg_tinyBoxt
+/// (2026-12-08), whose longest edges were of that kind, in two clusters at
+/// a corner and on a feature line: the longest edge went from 0.0890 to
+/// 0.0460 (against MMG3D `-hsiz`'s longest at the same count, 2.65× →
+/// 1.38×), its worst from 19.21° to 20.53°; mmg_cube's two-step worst
+/// and average rose from 20.59° / 49.91° to 20.67° / 49.99° (3 % fewer
+/// tets), the holed bar's and the tripod's moved by at most 0.03°. The
+/// off-edge point for every free interior edge whose on-edge split is
+/// refused, not only very long ones, made two steps of the ladder 6 %
+/// more tets in three times the time (its average 0.8° lower).
 fn split_point(
     mesh: &TetMesh,
     a: u32,
@@ -176,13 +212,13 @@ fn split_point(
     bar: f64,
     sh: &[u32],
     very_long: bool,
-) -> Option<f64> {
+) -> Option<DVec3> {
     let (pa, pb) = (mesh.point(a), mesh.point(b));
     let need = shell_worst(mesh, sh).min(bar);
     let worst_at = |t: f64| halves_worst(mesh, a, b, pa.lerp(pb, t), sh);
     let middle = worst_at(0.5);
     if middle >= need {
-        return Some(0.5);
+        return Some(pa.lerp(pb, 0.5));
     }
     let steps = (SPLIT_REACH / SPLIT_STEP).round() as i32;
     let (q, t) = (-steps..=steps)
@@ -192,12 +228,196 @@ fn split_point(
             (worst_at(t), t)
         })
         .fold((middle, 0.5), |best, x| if x.0 > best.0 { x } else { best });
-    let need = if very_long && is_free_interior_edge(mesh, a, b, sh) {
-        RELAXED_NEED * need
-    } else {
-        need
+    if q >= need {
+        return Some(pa.lerp(pb, t));
+    }
+    if is_free_interior_edge(mesh, a, b, sh) {
+        let on_edge = pa.lerp(pb, t);
+        if !very_long {
+            return None;
+        }
+        let need = RELAXED_NEED * need;
+        return match off_edge_point(mesh, a, b, sh, on_edge) {
+            Some((x, q_off)) if q_off >= need && q_off > q => Some(x),
+            _ => (q >= need).then_some(on_edge),
+        };
+    }
+    if let Some((x, _)) = flat_surface_sides(mesh, a, b, sh)
+        .and_then(|sides| in_plane_point(mesh, a, b, sh, t, sides))
+        .filter(|&(_, q_in)| q_in >= need)
+    {
+        return Some(x);
+    }
+    let far = steps + 1..=(FAR_REACH / SPLIT_STEP).round() as i32;
+    let (q, t) = far
+        .flat_map(|k| [-k, k])
+        .map(|k| {
+            let t = 0.5 + k as f64 * SPLIT_STEP;
+            (worst_at(t), t)
+        })
+        .fold((f64::NEG_INFINITY, 0.5), |best, x| {
+            if x.0 > best.0 {
+                x
+            } else {
+                best
+            }
+        });
+    (q >= need).then(|| pa.lerp(pb, t))
+}
+
+/// The optimiser's tuning for [`off_edge_point`]: as for an insertion
+/// ([`super::insertion`]), the new point starts on the edge, far from
+/// where it ends.
+const OFF_EDGE_PARAMS: OptimizeParams = OptimizeParams {
+    iterations: 40,
+    active_tol: 1e-3,
+    halvings: 10,
+};
+
+/// Where the new point of a free interior edge's split `(a, b)` (shell
+/// `sh`) raises the worst of its halves most, off the edge, and that
+/// worst: the optimisation-based smoothing of the new point's ball
+/// ([`optimize_position_in`]) started at `start`, a point of the edge.
+/// `None` where the optimiser finds no better point or the halves would
+/// not all stay positive there.
+///
+/// An edge from a fixed vertex whose ring lies near that end is split
+/// thinly at every point of the edge (the half on the far side of the
+/// ring is flat); off the edge, towards the ring's side, the halves are
+/// fat. The new point is free, so it may stand anywhere in the shell.
+fn off_edge_point(
+    mesh: &TetMesh,
+    a: u32,
+    b: u32,
+    sh: &[u32],
+    start: DVec3,
+) -> Option<(DVec3, f64)> {
+    let mut ball = BallPoints::default();
+    ball.load_edge_split(mesh, a, b, sh);
+    let (mut qs, mut trial) = (Vec::new(), Vec::new());
+    let (x, q) = optimize_position_in(&ball, start, &OFF_EDGE_PARAMS, &mut qs, &mut trial)?;
+    ball.stays_positive(x).then_some((x, q))
+}
+
+/// The third corners `c`, `d` of the two boundary faces at the surface
+/// edge `(a, b)` (shell `sh`) when they are the only constrained faces
+/// there ([`TetMesh::face_is_constrained`]), carry the same marker, the
+/// edge is not a feature edge, and `a, b, c, d` are coplanar by the exact
+/// `orient3d`: a new point anywhere in that plane inside `a c b d` leaves
+/// the domain as it is. `None` otherwise.
+fn flat_surface_sides(mesh: &TetMesh, a: u32, b: u32, sh: &[u32]) -> Option<[u32; 2]> {
+    if mesh.is_feature_edge(a, b) {
+        return None;
+    }
+    let mut sides = Vec::with_capacity(2);
+    for &t in sh {
+        let v = mesh.tet(t);
+        for f in 0..4 {
+            if v[f] == a || v[f] == b {
+                continue;
+            }
+            if mesh.is_interface_face(t, f) {
+                return None;
+            }
+            if mesh.is_boundary_face(t, f) {
+                // The face's third corner: neither `a`, `b` nor `v[f]`.
+                let c = (0..4)
+                    .map(|k| v[k])
+                    .find(|&x| x != a && x != b && x != v[f])?;
+                sides.push(c);
+            }
+        }
+    }
+    let [c, d] = sides[..] else { return None };
+    let (pa, pb, pc, pd) = (mesh.point(a), mesh.point(b), mesh.point(c), mesh.point(d));
+    let (normal_c, normal_d) = ((pb - pa).cross(pc - pa), (pb - pa).cross(pd - pa));
+    // `d`'s distance from the plane of `a, b, c`, and `c`'s from that of
+    // `a, b, d`, within FLAT_TOLERANCE of the edge's length.
+    let off = |p: DVec3, q: DVec3, n: DVec3| {
+        (q - p).dot(n).abs() <= FLAT_TOLERANCE * n.length() * (pb - pa).length()
     };
-    (q >= need).then_some(t)
+    (mesh.face_marker([a, b, c]) == mesh.face_marker([a, b, d])
+        && off(pa, pd, normal_c)
+        && off(pa, pc, normal_d))
+    .then_some([c, d])
+}
+
+/// How far, relative to the edge's length, a corner of the two boundary
+/// faces at an edge may stand off the other face's plane for the faces
+/// to count as one plane ([`flat_surface_sides`]). The boundary rules and
+/// the boundary smoother compute points of a planar patch by affine
+/// combinations and projections, which leave them an ulp or two off the
+/// plane (mmg_tinyBoxt's box faces after two steps: `y = 1 - 2⁻⁵²`); the
+/// exact `orient3d` then says "not coplanar". 1e-12 is thousands of ulps
+/// above that and a million times below any `--hausd` (a fraction of the
+/// local edge length): a new point on such a plane moves the domain by at
+/// most that much.
+const FLAT_TOLERANCE: f64 = 1e-12;
+
+/// Pattern-search steps of [`in_plane_point`] (each halves the step on
+/// failure).
+const IN_PLANE_ITERATIONS: usize = 24;
+
+/// Where, in the plane of the flat surface edge `(a, b)`'s two boundary
+/// faces (third corners `sides`, [`flat_surface_sides`]), the new point of
+/// its split raises the worst of its halves most, and that worst: a
+/// compass search over the edge's direction and the plane's direction
+/// square to it, started at the point `t` of the edge. Each coordinate on
+/// which the four corners agree (within [`FLAT_TOLERANCE`]) is set to
+/// `a`'s (an axis-aligned face stays on its plane to the bit); on other
+/// planes the point is within rounding of it. `None` where no positive position is found.
+///
+/// A surface edge ending at a box's corner is split thinly at every point
+/// of it where the ring's far vertex lies near one end; moved sideways in
+/// the plane, towards the side face that is wider, the halves are fat.
+fn in_plane_point(
+    mesh: &TetMesh,
+    a: u32,
+    b: u32,
+    sh: &[u32],
+    t: f64,
+    [c, d]: [u32; 2],
+) -> Option<(DVec3, f64)> {
+    let (pa, pb, pc, pd) = (mesh.point(a), mesh.point(b), mesh.point(c), mesh.point(d));
+    let along = pb - pa;
+    let across = along.cross(pc - pa).cross(along).normalize_or_zero() * along.length();
+    let mut ball = BallPoints::default();
+    ball.load_edge_split(mesh, a, b, sh);
+    let size = along.length();
+    let snap = |mut x: DVec3| {
+        for k in 0..3 {
+            let (lo, hi) = [pb[k], pc[k], pd[k]]
+                .into_iter()
+                .fold((pa[k], pa[k]), |(lo, hi), v| (lo.min(v), hi.max(v)));
+            if hi - lo <= FLAT_TOLERANCE * size {
+                x[k] = pa[k];
+            }
+        }
+        x
+    };
+    let worst = |x: DVec3| {
+        (0..ball.len())
+            .map(|i| ball.quality(i, x))
+            .fold(f64::INFINITY, f64::min)
+    };
+    let mut x = snap(pa.lerp(pb, t));
+    let mut q = worst(x);
+    let mut h = 0.1;
+    for _ in 0..IN_PLANE_ITERATIONS {
+        let best = [along, -along, across, -across]
+            .into_iter()
+            .map(|dir| {
+                let y = snap(x + h * dir);
+                (worst(y), y)
+            })
+            .fold((q, x), |best, y| if y.0 > best.0 { y } else { best });
+        if best.0 > q {
+            (q, x) = best;
+        } else {
+            h *= 0.5;
+        }
+    }
+    ball.stays_positive(x).then_some((x, q))
 }
 
 /// Whether `(a, b)` (shell `sh`) is neither a feature edge nor an edge of
@@ -450,7 +670,7 @@ pub(crate) fn split_long_edges(
             };
             at
         };
-        let p = mesh.point(a).lerp(mesh.point(b), at);
+        let p = at;
         let boundary_faces: usize = sh
             .iter()
             .map(|&t| {
