@@ -990,3 +990,159 @@ mod tests {
         assert_eq!(split_long_edges(&mut m, 1.4, cap, 0.3, None, true).edges, 8);
     }
 }
+
+/// The fallbacks of [`split_point`] on two shells taken from mmg_tinyBoxt
+/// after two default steps with the build before them (2026-12-07), near
+/// the box's corner (5, 1, 1) and the feature line y = z = 1, where every
+/// point of the edge cut a thin half. Coordinates as written by the
+/// `.mesh` writer (shortest round-trip form).
+#[cfg(test)]
+mod fallback_tests {
+    use super::*;
+    use crate::geom::tet_volume;
+    use crate::mesh::MeshData;
+
+    /// The mesh of `tets` over `points`, each tet turned positive.
+    fn mesh_of(points: &[[f64; 3]], tets: &[[u32; 4]]) -> TetMesh {
+        let tets = tets
+            .iter()
+            .map(|&t| {
+                let c = t.map(|i| DVec3::from_array(points[i as usize]));
+                if tet_volume(&c) > 0.0 {
+                    t
+                } else {
+                    [t[1], t[0], t[2], t[3]]
+                }
+            })
+            .collect();
+        let data = MeshData {
+            points: points.to_vec(),
+            tets,
+            ..Default::default()
+        };
+        TetMesh::from_data(&data).expect("a valid shell").0
+    }
+
+    /// The worst min-sine and the smallest volume of the tets made by
+    /// putting `p` in place of `a`, and in place of `b`, in each tet of
+    /// the shell of `(a, b)`: the halves of its split at `p`, built here
+    /// by hand.
+    fn halves_at(m: &TetMesh, a: u32, b: u32, p: DVec3) -> (f64, f64) {
+        let mut sh = Vec::new();
+        m.edge_shell(a, b, &mut sh);
+        let (mut worst, mut volume) = (f64::INFINITY, f64::INFINITY);
+        for &t in &sh {
+            for end in [a, b] {
+                let c = m.tet(t).map(|x| if x == end { p } else { m.point(x) });
+                worst = worst.min(tet_min_sine(&c));
+                volume = volume.min(tet_volume(&c));
+            }
+        }
+        (worst, volume)
+    }
+
+    /// The best worst half over the points of the edge `0.5 ± k·0.025`
+    /// for `k` up to `reach` steps.
+    fn best_on_edge(m: &TetMesh, reach: i32) -> f64 {
+        let (pa, pb) = (m.point(0), m.point(1));
+        (-reach..=reach)
+            .map(|k| halves_at(m, 0, 1, pa.lerp(pb, 0.5 + k as f64 * 0.025)).0)
+            .fold(f64::NEG_INFINITY, f64::max)
+    }
+
+    /// Distance of `x` from the line through points 0 and 1, over their
+    /// distance.
+    fn off_line(m: &TetMesh, x: DVec3) -> f64 {
+        let (pa, pb) = (m.point(0), m.point(1));
+        let t = (x - pa).dot(pb - pa) / (pb - pa).length_squared();
+        pa.lerp(pb, t).distance(x) / pa.distance(pb)
+    }
+
+    /// Splits the edge (0, 1) at `x` and checks the mesh and its volume.
+    fn split_and_check(m: &mut TetMesh, x: DVec3) {
+        let before: f64 = m.tet_ids().map(|t| tet_volume(&m.tet_points(t))).sum();
+        let mut sh = Vec::new();
+        m.edge_shell(0, 1, &mut sh);
+        let (_, new) = split_shell(m, 0, 1, x, &sh).expect("the split is made");
+        assert_eq!(new.len(), 2 * sh.len());
+        m.check().expect("a valid mesh after the split");
+        let after: f64 = m.tet_ids().map(|t| tet_volume(&m.tet_points(t))).sum();
+        assert!((after - before).abs() <= 1e-12 * before, "{before} {after}");
+    }
+
+    /// An edge from a point inside the box to its corner (5, 1, 1), whose
+    /// ring of six lies near the inner end: no point of the edge, out to
+    /// ±0.35 of it, gives halves at the lower bar of very long edges; a
+    /// point off the edge does.
+    #[test]
+    fn a_very_long_free_edge_no_point_of_which_splits_well_is_split_off_it() {
+        let points = [
+            [4.911174298152882, 0.9968813146689889, 0.9955211113897702],
+            [5.0, 1.0, 1.0],
+            [4.922719025000532, 1.0, 0.9952507813507827],
+            [4.936576634065602, 0.9948900707095202, 1.0],
+            [4.949839206614152, 1.0, 1.0],
+            [4.971047771548676, 0.9953483427425339, 0.9955974941631384],
+            [4.950003035679668, 0.995975398335145, 0.9922204078453402],
+            [4.94388935620968, 0.9983916541097334, 0.9925674224076461],
+        ];
+        let tets = [
+            [0, 1, 4, 3],
+            [0, 1, 5, 6],
+            [1, 4, 2, 0],
+            [0, 5, 1, 3],
+            [1, 7, 0, 2],
+            [0, 7, 1, 6],
+        ];
+        let mut m = mesh_of(&points, &tets);
+        let mut sh = Vec::new();
+        m.edge_shell(0, 1, &mut sh);
+        assert_eq!(sh.len(), 6);
+        let need = m
+            .tet_ids()
+            .map(|t| tet_min_sine(&m.tet_points(t)))
+            .fold(0.35, f64::min);
+        assert!(best_on_edge(&m, 14) < RELAXED_NEED * need);
+        // Not very long: left whole.
+        assert_eq!(split_point(&m, 0, 1, 0.35, &sh, false), None);
+        let x = split_point(&m, 0, 1, 0.35, &sh, true).expect("a point off the edge");
+        assert!(off_line(&m, x) > 1e-3, "{x}");
+        let (worst, volume) = halves_at(&m, 0, 1, x);
+        assert!(
+            worst >= RELAXED_NEED * need && volume > 0.0,
+            "{worst} {volume}"
+        );
+        split_and_check(&mut m, x);
+    }
+
+    /// A surface edge from the feature line y = z = 1 across the face
+    /// y = 1 (one ring point stands an ulp off it, as the boundary rules
+    /// leave it): within ±0.2 of its middle no point of the edge passes
+    /// the bar; the best point of the face's plane does, better than any
+    /// point of the edge out to ±0.35, and lies on y = 1 exactly.
+    #[test]
+    fn a_flat_surface_edge_is_split_at_the_best_point_of_its_plane() {
+        let points = [
+            [0.16896533199851982, 1.0, 0.9940035842527635],
+            [0.24155355735181644, 1.0, 1.0],
+            [0.17912992759288132, 0.9970539918804403, 0.9963120692475165],
+            [0.19087575931640627, 1.0, 1.0],
+            [0.202365200176345, 0.9960252304227388, 0.9922909927126888],
+            [0.19624647591882305, 0.9999999999999999, 0.991696786539015],
+        ];
+        let mut m = mesh_of(&points, &[[1, 3, 0, 2], [1, 5, 4, 0], [1, 4, 2, 0]]);
+        let mut sh = Vec::new();
+        m.edge_shell(0, 1, &mut sh);
+        let need = m
+            .tet_ids()
+            .map(|t| tet_min_sine(&m.tet_points(t)))
+            .fold(0.35, f64::min);
+        assert!(best_on_edge(&m, 8) < need);
+        let x = split_point(&m, 0, 1, 0.35, &sh, false).expect("a point of the plane");
+        assert_eq!(x.y, 1.0);
+        assert!(off_line(&m, x) > 1e-3, "{x}");
+        let (worst, volume) = halves_at(&m, 0, 1, x);
+        assert!(worst >= need && worst > best_on_edge(&m, 14) && volume > 0.0);
+        split_and_check(&mut m, x);
+    }
+}
