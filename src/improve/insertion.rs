@@ -101,9 +101,7 @@ pub(crate) fn plan_insertion(
             / (ring.verts.len() + 2) as f64;
         let mut found = (DVec3::ZERO, f64::NEG_INFINITY);
         for x0 in [0.5 * (pa + pb), centroid] {
-            let at_start = (0..s.ball.len())
-                .map(|i| s.ball.quality(i, x0))
-                .fold(f64::INFINITY, f64::min);
+            let at_start = s.ball.worst(x0);
             let (x, q) = optimize_position_in(&s.ball, x0, &PARAMS, &mut s.qualities, &mut s.trial)
                 .unwrap_or((x0, at_start));
             if q > found.1 {

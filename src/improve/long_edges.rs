@@ -128,10 +128,10 @@ const SPLIT_STEP: f64 = 0.025;
 const SPLIT_REACH: f64 = 0.2;
 /// How far from the middle the split of an edge whose new point must stay
 /// on it (a feature edge, an edge at a crease) is looked for when no point
-/// within [`SPLIT_REACH`] passes ([`split_point`]). Searching this far for
-/// every edge, out to 0.3 (instead of as a fallback), made mmg_tinyBoxt's one-step
-/// longest edge longer, 0.1231 → 0.1385 (2026-12-07): the best point of the
-/// wider range leaves thinner halves than a nearer point that passes.
+/// within [`SPLIT_REACH`] passes ([`split_point`]). Searching that far for
+/// every edge (out to 0.3, not as a fallback) made mmg_tinyBoxt's one-step
+/// longest edge longer, 0.1231 → 0.1385 (2026-12-07): the best point of
+/// the wider range leaves thinner halves than a nearer point that passes.
 const FAR_REACH: f64 = 0.35;
 
 /// An edge longer than this times the mean edge length at its ends (or
@@ -220,22 +220,25 @@ fn split_point(
     if middle >= need {
         return Some(pa.lerp(pb, 0.5));
     }
-    let steps = (SPLIT_REACH / SPLIT_STEP).round() as i32;
-    let (q, t) = (-steps..=steps)
-        .filter(|&k| k != 0)
-        .map(|k| {
+    // The best of `from` and the points `0.5 + k·SPLIT_STEP` for `k` in
+    // `ks`: (worst new tet, t).
+    let best_of = |ks: &mut dyn Iterator<Item = i32>, from: (f64, f64)| {
+        ks.map(|k| {
             let t = 0.5 + k as f64 * SPLIT_STEP;
             (worst_at(t), t)
         })
-        .fold((middle, 0.5), |best, x| if x.0 > best.0 { x } else { best });
+        .fold(from, |best, x| if x.0 > best.0 { x } else { best })
+    };
+    let steps = (SPLIT_REACH / SPLIT_STEP).round() as i32;
+    let (q, t) = best_of(&mut (-steps..=steps).filter(|&k| k != 0), (middle, 0.5));
     if q >= need {
         return Some(pa.lerp(pb, t));
     }
     if is_free_interior_edge(mesh, a, b, sh) {
-        let on_edge = pa.lerp(pb, t);
         if !very_long {
             return None;
         }
+        let on_edge = pa.lerp(pb, t);
         let need = RELAXED_NEED * need;
         return match off_edge_point(mesh, a, b, sh, on_edge) {
             Some((x, q_off)) if q_off >= need && q_off > q => Some(x),
@@ -249,19 +252,7 @@ fn split_point(
         return Some(x);
     }
     let far = steps + 1..=(FAR_REACH / SPLIT_STEP).round() as i32;
-    let (q, t) = far
-        .flat_map(|k| [-k, k])
-        .map(|k| {
-            let t = 0.5 + k as f64 * SPLIT_STEP;
-            (worst_at(t), t)
-        })
-        .fold((f64::NEG_INFINITY, 0.5), |best, x| {
-            if x.0 > best.0 {
-                x
-            } else {
-                best
-            }
-        });
+    let (q, t) = best_of(&mut far.flat_map(|k| [-k, k]), (f64::NEG_INFINITY, 0.5));
     (q >= need).then(|| pa.lerp(pb, t))
 }
 
@@ -302,9 +293,9 @@ fn off_edge_point(
 /// The third corners `c`, `d` of the two boundary faces at the surface
 /// edge `(a, b)` (shell `sh`) when they are the only constrained faces
 /// there ([`TetMesh::face_is_constrained`]), carry the same marker, the
-/// edge is not a feature edge, and `a, b, c, d` are coplanar by the exact
-/// `orient3d`: a new point anywhere in that plane inside `a c b d` leaves
-/// the domain as it is. `None` otherwise.
+/// edge is not a feature edge, and `a, b, c, d` are coplanar within
+/// [`FLAT_TOLERANCE`]: a new point in that plane inside `a c b d` leaves
+/// the domain as it is (up to that tolerance). `None` otherwise.
 fn flat_surface_sides(mesh: &TetMesh, a: u32, b: u32, sh: &[u32]) -> Option<[u32; 2]> {
     if mesh.is_feature_edge(a, b) {
         return None;
@@ -365,7 +356,8 @@ const IN_PLANE_ITERATIONS: usize = 24;
 /// square to it, started at the point `t` of the edge. Each coordinate on
 /// which the four corners agree (within [`FLAT_TOLERANCE`]) is set to
 /// `a`'s (an axis-aligned face stays on its plane to the bit); on other
-/// planes the point is within rounding of it. `None` where no positive position is found.
+/// planes the point is within rounding of it. `None` where the halves at
+/// the point found would not all be positive.
 ///
 /// A surface edge ending at a box's corner is split thinly at every point
 /// of it where the ring's far vertex lies near one end; moved sideways in
@@ -383,32 +375,26 @@ fn in_plane_point(
     let across = along.cross(pc - pa).cross(along).normalize_or_zero() * along.length();
     let mut ball = BallPoints::default();
     ball.load_edge_split(mesh, a, b, sh);
-    let size = along.length();
     let snap = |mut x: DVec3| {
         for k in 0..3 {
             let (lo, hi) = [pb[k], pc[k], pd[k]]
                 .into_iter()
                 .fold((pa[k], pa[k]), |(lo, hi), v| (lo.min(v), hi.max(v)));
-            if hi - lo <= FLAT_TOLERANCE * size {
+            if hi - lo <= FLAT_TOLERANCE * along.length() {
                 x[k] = pa[k];
             }
         }
         x
     };
-    let worst = |x: DVec3| {
-        (0..ball.len())
-            .map(|i| ball.quality(i, x))
-            .fold(f64::INFINITY, f64::min)
-    };
     let mut x = snap(pa.lerp(pb, t));
-    let mut q = worst(x);
+    let mut q = ball.worst(x);
     let mut h = 0.1;
     for _ in 0..IN_PLANE_ITERATIONS {
         let best = [along, -along, across, -across]
             .into_iter()
             .map(|dir| {
                 let y = snap(x + h * dir);
-                (worst(y), y)
+                (ball.worst(y), y)
             })
             .fold((q, x), |best, y| if y.0 > best.0 { y } else { best });
         if best.0 > q {
@@ -650,8 +636,8 @@ pub(crate) fn split_long_edges(
         // the pieces of every ball as they were, so a ball found whole
         // stays whole.)
         let found = &shells[e.shell];
-        // Where along the edge it is split (see `split_point`).
-        let at = if e.whole_ball
+        // Where the new point goes (see `split_point`).
+        let p = if e.whole_ball
             && found
                 .iter()
                 .all(|&(t, g)| mesh.is_alive(t) && mesh.generation(t) == g)
@@ -670,7 +656,6 @@ pub(crate) fn split_long_edges(
             };
             at
         };
-        let p = at;
         let boundary_faces: usize = sh
             .iter()
             .map(|&t| {
@@ -1000,6 +985,7 @@ mod tests {
 mod fallback_tests {
     use super::*;
     use crate::geom::tet_volume;
+    use crate::mesh::generate::total_volume;
     use crate::mesh::MeshData;
 
     /// The mesh of `tets` over `points`, each tet turned positive.
@@ -1060,13 +1046,13 @@ mod fallback_tests {
 
     /// Splits the edge (0, 1) at `x` and checks the mesh and its volume.
     fn split_and_check(m: &mut TetMesh, x: DVec3) {
-        let before: f64 = m.tet_ids().map(|t| tet_volume(&m.tet_points(t))).sum();
+        let before = total_volume(m);
         let mut sh = Vec::new();
         m.edge_shell(0, 1, &mut sh);
         let (_, new) = split_shell(m, 0, 1, x, &sh).expect("the split is made");
         assert_eq!(new.len(), 2 * sh.len());
         m.check().expect("a valid mesh after the split");
-        let after: f64 = m.tet_ids().map(|t| tet_volume(&m.tet_points(t))).sum();
+        let after = total_volume(m);
         assert!((after - before).abs() <= 1e-12 * before, "{before} {after}");
     }
 

@@ -193,6 +193,14 @@ impl BallPoints {
         tet_min_sine(&self.tet_with(i, x))
     }
 
+    /// The ball's worst quality with the vertex at `x` (NaN ignored, as
+    /// `f64::min` ignores it).
+    pub(crate) fn worst(&self, x: DVec3) -> f64 {
+        (0..self.len())
+            .map(|i| self.quality(i, x))
+            .fold(f64::INFINITY, f64::min)
+    }
+
     /// The ball's qualities with the vertex at `x`, into `out` (cleared
     /// first), if every one is above `bar` (a NaN quality counts as above,
     /// as `f64::min` ignores it); `None` at the first that is not.
